@@ -1,0 +1,863 @@
+//! The graphics state: what pbrt-v3's api.cpp keeps while reading (the current transforms, the
+//! attribute stack, named coordinate systems, materials, textures, area lights, object
+//! definitions), turning each directive into entries of a [`SceneDescription`].
+
+use crate::error::{Error, Result, Warning};
+use crate::mesh::Mesh;
+use crate::params::{ParamList, ParamType, Values};
+use crate::parser::{did_you_mean, io_message, resolve_path};
+use crate::scene::{
+    CameraDesc, InstanceDesc, LightDesc, MaterialDesc, ObjectDesc, PluginDesc, SceneDescription,
+    ShapeDesc, TextureDesc, TextureValue,
+};
+use crate::source::{Loc, SourceFile};
+use crate::transform::AnimatedTransform;
+use glam::DMat4;
+use indexmap::IndexMap;
+use std::collections::{HashMap, HashSet};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The state that `AttributeBegin` saves and `AttributeEnd` restores. Name tables are shared
+/// until changed (copy on write), so deep attribute nesting stays cheap.
+#[derive(Clone)]
+struct GraphicsState {
+    material: Option<usize>,
+    area_light: Option<Arc<PluginDesc>>,
+    reverse_orientation: bool,
+    named_materials: Arc<IndexMap<String, usize>>,
+    float_textures: Arc<IndexMap<String, usize>>,
+    spectrum_textures: Arc<IndexMap<String, usize>>,
+}
+
+/// The start and end current transformation matrices.
+type Ctm = [DMat4; 2];
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Block {
+    Attribute,
+    Transform,
+    Object,
+}
+
+impl Block {
+    fn begin_name(self) -> &'static str {
+        match self {
+            Block::Attribute => "AttributeBegin",
+            Block::Transform => "TransformBegin",
+            Block::Object => "ObjectBegin",
+        }
+    }
+}
+
+struct Saved {
+    block: Block,
+    graphics: Option<GraphicsState>,
+    ctm: Ctm,
+    active: [bool; 2],
+    loc: Loc,
+}
+
+/// Where we are in the file's structure.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    Options,
+    World,
+    Done,
+}
+
+/// Builds a [`SceneDescription`] from directives, as pbrt-v3's API functions do.
+pub struct Builder {
+    main: Arc<SourceFile>,
+    scene: SceneDescription,
+    phase: Phase,
+    ctm: Ctm,
+    active: [bool; 2],
+    named_coordinate_systems: HashMap<String, Ctm>,
+    graphics: GraphicsState,
+    stack: Vec<Saved>,
+    current_object: Option<(String, ObjectDesc)>,
+    warned_once: HashSet<String>,
+    ply_cache: HashMap<PathBuf, Arc<Mesh>>,
+}
+
+impl Builder {
+    /// A builder for the scene whose main file is `main`.
+    pub fn new(main: Arc<SourceFile>) -> Self {
+        let default_material = MaterialDesc {
+            name: None,
+            plugin: PluginDesc {
+                kind: "matte".to_owned(),
+                params: ParamList::new(),
+                loc: Loc::new(&main, 0),
+            },
+            mix: None,
+        };
+        Self {
+            scene: SceneDescription {
+                files: vec![Arc::clone(&main)],
+                camera: None,
+                film: None,
+                sampler: None,
+                filter: None,
+                integrator: None,
+                accelerator: None,
+                transform_times: (0.0, 1.0),
+                materials: vec![default_material],
+                named_materials: IndexMap::new(),
+                textures: Vec::new(),
+                lights: Vec::new(),
+                shapes: Vec::new(),
+                objects: IndexMap::new(),
+                instances: Vec::new(),
+                warnings: Vec::new(),
+            },
+            main,
+            phase: Phase::Options,
+            ctm: [DMat4::IDENTITY; 2],
+            active: [true; 2],
+            named_coordinate_systems: HashMap::new(),
+            graphics: GraphicsState {
+                material: Some(0),
+                area_light: None,
+                reverse_orientation: false,
+                named_materials: Arc::default(),
+                float_textures: Arc::default(),
+                spectrum_textures: Arc::default(),
+            },
+            stack: Vec::new(),
+            current_object: None,
+            warned_once: HashSet::new(),
+            ply_cache: HashMap::new(),
+        }
+    }
+
+    /// The main scene file.
+    pub fn main_file(&self) -> &Arc<SourceFile> {
+        &self.main
+    }
+
+    /// Records a file read through `Include`.
+    pub fn add_file(&mut self, file: Arc<SourceFile>) {
+        self.scene.files.push(file);
+    }
+
+    /// Adds a warning.
+    pub fn warn(&mut self, loc: &Loc, message: impl Into<String>) {
+        self.scene.warnings.push(Warning::at(loc, message));
+    }
+
+    /// Warns about an unsupported feature the first time it is met.
+    pub fn unsupported_once(&mut self, directive: &str, loc: &Loc, what: &str) {
+        if self.warned_once.insert(directive.to_owned()) {
+            self.warn(
+                loc,
+                format!("{what} ({directive}) are not supported; ignored here and hereafter"),
+            );
+        }
+    }
+
+    /// Directives after `WorldEnd` are errors: acr renders one image per file.
+    pub fn check_after_world_end(&self, directive: &str, loc: &Loc) -> Result<()> {
+        if self.phase == Phase::Done {
+            return Err(Error::at(
+                loc,
+                format!("{directive} after WorldEnd: a scene file describes one image"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn require_world(&self, directive: &str, loc: &Loc) -> Result<()> {
+        if self.phase != Phase::World {
+            return Err(Error::at(
+                loc,
+                format!("{directive} is only allowed between WorldBegin and WorldEnd"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn require_options(&self, directive: &str, loc: &Loc) -> Result<()> {
+        if self.phase != Phase::Options {
+            return Err(Error::at(
+                loc,
+                format!("{directive} must come before WorldBegin"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn animated(&self) -> AnimatedTransform {
+        AnimatedTransform {
+            start: self.ctm[0],
+            end: self.ctm[1],
+            start_time: self.scene.transform_times.0,
+            end_time: self.scene.transform_times.1,
+        }
+    }
+
+    /// Multiplies the active transforms by `m` on the right (pbrt's order).
+    pub fn concat(&mut self, m: DMat4) {
+        for i in 0..2 {
+            if self.active[i] {
+                self.ctm[i] *= m;
+            }
+        }
+    }
+
+    /// Replaces the active transforms by `m`.
+    pub fn set_transform(&mut self, m: DMat4) {
+        for i in 0..2 {
+            if self.active[i] {
+                self.ctm[i] = m;
+            }
+        }
+    }
+
+    /// `CoordinateSystem`: names the current transforms.
+    pub fn coordinate_system(&mut self, name: String) {
+        self.named_coordinate_systems.insert(name, self.ctm);
+    }
+
+    /// `CoordSysTransform`: restores named transforms.
+    pub fn coord_sys_transform(&mut self, name: &str, loc: &Loc) -> Result<()> {
+        let Some(saved) = self.named_coordinate_systems.get(name).copied() else {
+            let known: Vec<&str> = self
+                .named_coordinate_systems
+                .keys()
+                .map(String::as_str)
+                .collect();
+            return Err(Error::at(
+                loc,
+                format!(
+                    "no coordinate system named \"{name}\"{}",
+                    did_you_mean(name, known)
+                ),
+            ));
+        };
+        for i in 0..2 {
+            if self.active[i] {
+                self.ctm[i] = saved[i];
+            }
+        }
+        Ok(())
+    }
+
+    /// `TransformTimes`.
+    pub fn transform_times(&mut self, start: f64, end: f64, loc: &Loc) -> Result<()> {
+        self.require_options("TransformTimes", loc)?;
+        if end < start {
+            return Err(Error::at(
+                loc,
+                format!("TransformTimes: end time {end} is before start time {start}"),
+            ));
+        }
+        self.scene.transform_times = (start, end);
+        Ok(())
+    }
+
+    /// `ActiveTransform StartTime|EndTime|All`.
+    pub fn active_transform(&mut self, which: &str, loc: &Loc) -> Result<()> {
+        self.active = match which {
+            "StartTime" => [true, false],
+            "EndTime" => [false, true],
+            "All" => [true, true],
+            _ => {
+                return Err(Error::at(
+                    loc,
+                    format!(
+                        "ActiveTransform needs StartTime, EndTime or All, not '{which}'{}",
+                        did_you_mean(which, ["StartTime", "EndTime", "All"])
+                    ),
+                ))
+            }
+        };
+        Ok(())
+    }
+
+    /// `ReverseOrientation`.
+    pub fn reverse_orientation(&mut self, loc: &Loc) -> Result<()> {
+        self.require_world("ReverseOrientation", loc)?;
+        self.graphics.reverse_orientation = !self.graphics.reverse_orientation;
+        Ok(())
+    }
+
+    /// `WorldBegin`.
+    pub fn world_begin(&mut self, loc: &Loc) -> Result<()> {
+        if self.phase != Phase::Options {
+            return Err(Error::at(loc, "WorldBegin appears twice"));
+        }
+        if let Some(open) = self.stack.last() {
+            return Err(Error::at(
+                loc,
+                format!(
+                    "WorldBegin inside the {} at {}",
+                    open.block.begin_name(),
+                    open.loc
+                ),
+            ));
+        }
+        self.phase = Phase::World;
+        self.ctm = [DMat4::IDENTITY; 2];
+        self.active = [true; 2];
+        self.named_coordinate_systems
+            .insert("world".to_owned(), self.ctm);
+        Ok(())
+    }
+
+    /// `WorldEnd`.
+    pub fn world_end(&mut self, loc: &Loc) -> Result<()> {
+        self.require_world("WorldEnd", loc)?;
+        self.warn_open_blocks();
+        self.phase = Phase::Done;
+        Ok(())
+    }
+
+    fn warn_open_blocks(&mut self) {
+        let open: Vec<(Loc, &'static str)> = self
+            .stack
+            .iter()
+            .map(|s| (s.loc.clone(), s.block.begin_name()))
+            .collect();
+        // One warning for the outermost: deep nesting would otherwise flood the output.
+        if let Some((loc, name)) = open.first() {
+            self.warn(
+                loc,
+                format!("{name} is never closed ({} blocks open in all)", open.len()),
+            );
+        }
+    }
+
+    /// Called once after the last token of the main file.
+    pub fn end_of_input(&mut self, end: &Loc) {
+        if self.phase == Phase::World {
+            self.warn_open_blocks();
+            self.warn(end, "the file ends without WorldEnd");
+        }
+    }
+
+    fn push(&mut self, block: Block, loc: &Loc) {
+        let graphics = (block != Block::Transform).then(|| self.graphics.clone());
+        self.stack.push(Saved {
+            block,
+            graphics,
+            ctm: self.ctm,
+            active: self.active,
+            loc: loc.clone(),
+        });
+    }
+
+    fn pop(&mut self, block: Block, end_name: &str, loc: &Loc) -> Result<()> {
+        match self.stack.last() {
+            None => Err(Error::at(
+                loc,
+                format!("{end_name} without a matching {}", block.begin_name()),
+            )),
+            Some(top) if top.block != block => Err(Error::at(
+                loc,
+                format!(
+                    "{end_name} closes the {} at {}",
+                    top.block.begin_name(),
+                    top.loc
+                ),
+            )),
+            Some(_) => {
+                if let Some(saved) = self.stack.pop() {
+                    if let Some(g) = saved.graphics {
+                        self.graphics = g;
+                    }
+                    self.ctm = saved.ctm;
+                    self.active = saved.active;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// `AttributeBegin`.
+    pub fn attribute_begin(&mut self, loc: &Loc) -> Result<()> {
+        self.require_world("AttributeBegin", loc)?;
+        self.push(Block::Attribute, loc);
+        Ok(())
+    }
+
+    /// `AttributeEnd`.
+    pub fn attribute_end(&mut self, loc: &Loc) -> Result<()> {
+        self.require_world("AttributeEnd", loc)?;
+        self.pop(Block::Attribute, "AttributeEnd", loc)
+    }
+
+    /// `TransformBegin` (allowed before the world too, as in pbrt-v3).
+    pub fn transform_begin(&mut self, loc: &Loc) -> Result<()> {
+        self.push(Block::Transform, loc);
+        Ok(())
+    }
+
+    /// `TransformEnd`.
+    pub fn transform_end(&mut self, loc: &Loc) -> Result<()> {
+        self.pop(Block::Transform, "TransformEnd", loc)
+    }
+
+    /// `ObjectBegin "name"`: starts an object definition (and, as in pbrt-v3, an attribute block).
+    pub fn object_begin(&mut self, name: String, loc: &Loc) -> Result<()> {
+        self.require_world("ObjectBegin", loc)?;
+        if let Some((outer, def)) = &self.current_object {
+            return Err(Error::at(
+                loc,
+                format!(
+                    "ObjectBegin \"{name}\" inside the definition of \"{outer}\" begun at {}",
+                    def.loc
+                ),
+            ));
+        }
+        self.push(Block::Object, loc);
+        self.current_object = Some((
+            name,
+            ObjectDesc {
+                shapes: Vec::new(),
+                loc: loc.clone(),
+            },
+        ));
+        Ok(())
+    }
+
+    /// `ObjectEnd`.
+    pub fn object_end(&mut self, loc: &Loc) -> Result<()> {
+        self.require_world("ObjectEnd", loc)?;
+        self.pop(Block::Object, "ObjectEnd", loc)?;
+        if let Some((name, def)) = self.current_object.take() {
+            if let Some(old) = self.scene.objects.get(&name) {
+                let old_loc = old.loc.clone();
+                self.warn(
+                    loc,
+                    format!("object \"{name}\" redefined (first defined at {old_loc})"),
+                );
+            }
+            self.scene.objects.insert(name, def);
+        }
+        Ok(())
+    }
+
+    /// `ObjectInstance "name"`.
+    pub fn object_instance(&mut self, name: &str, loc: &Loc) -> Result<()> {
+        self.require_world("ObjectInstance", loc)?;
+        if let Some((outer, _)) = &self.current_object {
+            return Err(Error::at(
+                loc,
+                format!("ObjectInstance inside the definition of object \"{outer}\""),
+            ));
+        }
+        let Some(object) = self.scene.objects.get_index_of(name) else {
+            let known = self.scene.objects.keys().map(String::as_str);
+            return Err(Error::at(
+                loc,
+                format!("no object named \"{name}\"{}", did_you_mean(name, known)),
+            ));
+        };
+        self.scene.instances.push(InstanceDesc {
+            object,
+            world_from_instance: self.animated(),
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+
+    /// `NamedMaterial "name"`.
+    pub fn named_material(&mut self, name: &str, loc: &Loc) -> Result<()> {
+        self.require_world("NamedMaterial", loc)?;
+        match self.graphics.named_materials.get(name) {
+            Some(&i) => {
+                self.graphics.material = Some(i);
+                Ok(())
+            }
+            None => Err(self.unknown_material(name, loc)),
+        }
+    }
+
+    fn unknown_material(&self, name: &str, loc: &Loc) -> Error {
+        let known = self.graphics.named_materials.keys().map(String::as_str);
+        Error::at(
+            loc,
+            format!("no material named \"{name}\"{}", did_you_mean(name, known)),
+        )
+    }
+
+    /// Resolves every texture parameter against the textures in scope.
+    fn resolve_textures(&self, params: &mut ParamList) -> Result<()> {
+        for p in params.iter_mut() {
+            if let Values::Texture(t) = &mut p.values {
+                t.float = self.graphics.float_textures.get(&t.name).copied();
+                t.spectrum = self.graphics.spectrum_textures.get(&t.name).copied();
+                if t.float.is_none() && t.spectrum.is_none() {
+                    let known = self
+                        .graphics
+                        .float_textures
+                        .keys()
+                        .chain(self.graphics.spectrum_textures.keys())
+                        .map(String::as_str);
+                    return Err(Error::at(
+                        &p.loc,
+                        format!(
+                            "no texture named \"{}\"{}",
+                            t.name,
+                            did_you_mean(&t.name, known)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// For `mix`: the materials its `namedmaterial1` and `namedmaterial2` name.
+    fn resolve_mix(&self, plugin: &PluginDesc) -> Result<Option<[usize; 2]>> {
+        if plugin.kind != "mix" {
+            return Ok(None);
+        }
+        let mut out = [0; 2];
+        for (slot, key) in out.iter_mut().zip(["namedmaterial1", "namedmaterial2"]) {
+            let Some(name) = plugin.params.string(key)? else {
+                return Err(Error::at(
+                    &plugin.loc,
+                    format!("mix material needs \"string {key}\""),
+                ));
+            };
+            let loc = plugin
+                .params
+                .get(key)
+                .map_or_else(|| plugin.loc.clone(), |p| p.loc.clone());
+            *slot = *self
+                .graphics
+                .named_materials
+                .get(name)
+                .ok_or_else(|| self.unknown_material(name, &loc))?;
+        }
+        Ok(Some(out))
+    }
+
+    fn add_material(&mut self, name: Option<String>, mut plugin: PluginDesc) -> Result<usize> {
+        self.resolve_textures(&mut plugin.params)?;
+        let mix = self.resolve_mix(&plugin)?;
+        self.scene.materials.push(MaterialDesc { name, plugin, mix });
+        Ok(self.scene.materials.len() - 1)
+    }
+
+    /// `Texture "name" "float|color|spectrum" "class" params`.
+    pub fn texture(
+        &mut self,
+        name: String,
+        value: &str,
+        class: String,
+        mut params: ParamList,
+        loc: Loc,
+    ) -> Result<()> {
+        self.require_world("Texture", &loc)?;
+        let value = match value {
+            "float" => TextureValue::Float,
+            "color" | "spectrum" | "rgb" => TextureValue::Spectrum,
+            other => {
+                return Err(Error::at(
+                    &loc,
+                    format!("texture type must be \"float\" or \"color\"/\"spectrum\", not \"{other}\""),
+                ))
+            }
+        };
+        self.resolve_textures(&mut params)?;
+        let index = self.scene.textures.len();
+        let table = match value {
+            TextureValue::Float => &mut self.graphics.float_textures,
+            TextureValue::Spectrum => &mut self.graphics.spectrum_textures,
+        };
+        let previous = Arc::make_mut(table).insert(name.clone(), index);
+        if previous.is_some() {
+            self.warn(&loc, format!("texture \"{name}\" redefined"));
+        }
+        self.scene.textures.push(TextureDesc {
+            name,
+            value,
+            plugin: PluginDesc {
+                kind: class,
+                params,
+                loc,
+            },
+            world_from_texture: self.ctm[0],
+        });
+        Ok(())
+    }
+
+    /// Every directive of the form `Name "type" params`.
+    pub fn plugin_directive(
+        &mut self,
+        directive: &str,
+        kind: String,
+        params: ParamList,
+        loc: Loc,
+    ) -> Result<()> {
+        let plugin = PluginDesc { kind, params, loc };
+        let loc = plugin.loc.clone();
+        match directive {
+            "Camera" => {
+                self.require_options(directive, &loc)?;
+                let camera_from_world = self.animated();
+                // pbrt-v3 names the camera's space so that lights can be placed in it.
+                self.named_coordinate_systems.insert(
+                    "camera".to_owned(),
+                    [self.ctm[0].inverse(), self.ctm[1].inverse()],
+                );
+                if let Some(old) = &self.scene.camera {
+                    let old_loc = old.plugin.loc.clone();
+                    self.warn(
+                        &loc,
+                        format!("{directive} given again (first at {old_loc}); this one is used"),
+                    );
+                }
+                self.scene.camera = Some(CameraDesc {
+                    plugin,
+                    camera_from_world,
+                });
+            }
+            "Film" | "Sampler" | "PixelFilter" | "Integrator" | "Accelerator" => {
+                self.require_options(directive, &loc)?;
+                fn slot<'s>(s: &'s mut SceneDescription, directive: &str) -> &'s mut Option<PluginDesc> {
+                    match directive {
+                        "Film" => &mut s.film,
+                        "Sampler" => &mut s.sampler,
+                        "PixelFilter" => &mut s.filter,
+                        "Integrator" => &mut s.integrator,
+                        _ => &mut s.accelerator,
+                    }
+                }
+                if let Some(old) = slot(&mut self.scene, directive) {
+                    let old_loc = old.loc.clone();
+                    self.warn(
+                        &loc,
+                        format!("{directive} given again (first at {old_loc}); this one is used"),
+                    );
+                }
+                *slot(&mut self.scene, directive) = Some(plugin);
+            }
+            "Material" => {
+                self.require_world(directive, &loc)?;
+                self.graphics.material = if plugin.kind.is_empty() || plugin.kind == "none" {
+                    None
+                } else {
+                    Some(self.add_material(None, plugin)?)
+                };
+            }
+            "MakeNamedMaterial" => {
+                self.require_world(directive, &loc)?;
+                let name = plugin.kind;
+                let ty = plugin.params.string("type")?.map(str::to_owned);
+                let Some(ty) = ty else {
+                    return Err(Error::at(
+                        &loc,
+                        format!("MakeNamedMaterial \"{name}\" needs a \"string type\" parameter"),
+                    ));
+                };
+                let index = self.add_material(
+                    Some(name.clone()),
+                    PluginDesc {
+                        kind: ty,
+                        params: plugin.params,
+                        loc: plugin.loc,
+                    },
+                )?;
+                if Arc::make_mut(&mut self.graphics.named_materials)
+                    .insert(name.clone(), index)
+                    .is_some()
+                {
+                    self.warn(&loc, format!("named material \"{name}\" redefined"));
+                }
+                self.scene.named_materials.insert(name, index);
+            }
+            "LightSource" => {
+                self.require_world(directive, &loc)?;
+                if self.current_object.is_some() {
+                    return Err(Error::at(
+                        &loc,
+                        "LightSource inside an object definition is not supported",
+                    ));
+                }
+                self.scene.lights.push(LightDesc {
+                    plugin,
+                    world_from_light: self.ctm[0],
+                });
+            }
+            "AreaLightSource" => {
+                self.require_world(directive, &loc)?;
+                self.graphics.area_light = Some(Arc::new(plugin));
+            }
+            "Shape" => {
+                self.require_world(directive, &loc)?;
+                self.shape(plugin)?;
+            }
+            "MakeNamedMedium" => self.unsupported_once(directive, &loc, "participating media"),
+            _ => {
+                return Err(Error::at(
+                    &loc,
+                    format!("internal: {directive} has no handler"),
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    fn shape(&mut self, mut plugin: PluginDesc) -> Result<()> {
+        let mesh = match plugin.kind.as_str() {
+            "trianglemesh" => Some(Arc::new(triangle_mesh(&plugin)?)),
+            "plymesh" => Some(self.ply_mesh(&plugin)?),
+            _ => None,
+        };
+        self.resolve_textures(&mut plugin.params)?;
+        let mut area_light = self.graphics.area_light.clone();
+        if area_light.is_some() && self.current_object.is_some() {
+            self.warn(
+                &plugin.loc,
+                "area lights are not supported inside object definitions (as in pbrt-v3); \
+                 this shape does not emit",
+            );
+            area_light = None;
+        }
+        let shape = ShapeDesc {
+            plugin,
+            world_from_object: self.animated(),
+            reverse_orientation: self.graphics.reverse_orientation,
+            material: self.graphics.material,
+            area_light,
+            mesh,
+        };
+        match &mut self.current_object {
+            Some((_, def)) => def.shapes.push(shape),
+            None => self.scene.shapes.push(shape),
+        }
+        Ok(())
+    }
+
+    fn ply_mesh(&mut self, plugin: &PluginDesc) -> Result<Arc<Mesh>> {
+        let Some(name) = plugin.params.string("filename")? else {
+            return Err(Error::at(
+                &plugin.loc,
+                "plymesh needs a \"string filename\" parameter",
+            ));
+        };
+        let loc = plugin
+            .params
+            .get("filename")
+            .map_or_else(|| plugin.loc.clone(), |p| p.loc.clone());
+        let path = resolve_path(name, &loc.file, self.main.dir());
+        if let Some(mesh) = self.ply_cache.get(&path) {
+            return Ok(Arc::clone(mesh));
+        }
+        let bytes = std::fs::read(&path).map_err(|e| {
+            Error::at(
+                &loc,
+                format!("cannot read PLY file \"{name}\": {}", io_message(&e)),
+            )
+        })?;
+        let ply = crate::ply::parse_ply(&bytes)
+            .map_err(|m| Error::at(&loc, format!("PLY file \"{name}\": {m}")))?;
+        for w in ply.warnings {
+            self.warn(&loc, format!("PLY file \"{name}\": {w}"));
+        }
+        let mesh = Arc::new(ply.mesh);
+        self.ply_cache.insert(path, Arc::clone(&mesh));
+        Ok(mesh)
+    }
+
+    /// The finished description.
+    pub fn finish(self) -> SceneDescription {
+        self.scene
+    }
+}
+
+/// The mesh of a `trianglemesh` shape, checked as pbrt-v3 checks it.
+fn triangle_mesh(plugin: &PluginDesc) -> Result<Mesh> {
+    let params = &plugin.params;
+    let err_at = |name: &str, message: String| {
+        let loc = params
+            .get(name)
+            .map_or_else(|| plugin.loc.clone(), |p| p.loc.clone());
+        Error::at(&loc, message)
+    };
+    let Some(p) = params.numbers("P", ParamType::Point3)? else {
+        return Err(Error::at(
+            &plugin.loc,
+            "trianglemesh needs a \"point3 P\" parameter",
+        ));
+    };
+    let positions: Vec<[f32; 3]> = p
+        .chunks_exact(3)
+        .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+        .collect();
+    let indices: Vec<u32> = match params.ints("indices")? {
+        Some(ix) => ix
+            .iter()
+            .map(|&i| {
+                u32::try_from(i)
+                    .map_err(|_| err_at("indices", format!("trianglemesh: negative vertex index {i}")))
+            })
+            .collect::<Result<_>>()?,
+        // pbrt-v4 allows a single triangle without indices.
+        None if positions.len() == 3 => vec![0, 1, 2],
+        None => {
+            return Err(Error::at(
+                &plugin.loc,
+                "trianglemesh needs an \"integer indices\" parameter",
+            ))
+        }
+    };
+    let normals = params
+        .numbers("N", ParamType::Normal)?
+        .map(|n| {
+            n.chunks_exact(3)
+                .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+                .collect::<Vec<_>>()
+        });
+    let uv_param = ["uv", "st"].into_iter().find_map(|k| params.get(k));
+    let uvs = match uv_param {
+        Some(param) => match (&param.values, param.ty) {
+            (Values::Floats(v), ParamType::Float | ParamType::Point2) => Some(
+                v.chunks_exact(2)
+                    .map(|c| [c[0] as f32, c[1] as f32])
+                    .collect::<Vec<_>>(),
+            ),
+            _ => {
+                return Err(Error::at(
+                    &param.loc,
+                    format!(
+                        "trianglemesh: \"{}\" must be float or point2, not {}",
+                        param.name,
+                        param.ty.name()
+                    ),
+                ))
+            }
+        },
+        None => None,
+    };
+    if let Some(param) = uv_param {
+        if let Values::Floats(v) = &param.values {
+            if v.len() != 2 * positions.len() {
+                return Err(Error::at(
+                    &param.loc,
+                    format!(
+                        "trianglemesh: {} \"{}\" values for {} vertices (expected {})",
+                        v.len(),
+                        param.name,
+                        positions.len(),
+                        2 * positions.len()
+                    ),
+                ));
+            }
+        }
+    }
+    let mesh = Mesh {
+        positions,
+        normals,
+        uvs,
+        indices,
+    };
+    mesh.validate()
+        .map_err(|m| err_at("indices", format!("trianglemesh: {m}")))?;
+    Ok(mesh)
+}

@@ -1,0 +1,113 @@
+//! Source files and byte-offset locations, resolved to line:column only when reported.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// One scene file's text, kept so that any later diagnostic can quote its line.
+#[derive(Debug)]
+pub struct SourceFile {
+    /// The path as the user (or the including file) named it.
+    pub path: PathBuf,
+    /// The whole text of the file.
+    pub text: Arc<str>,
+}
+
+impl SourceFile {
+    /// Wraps a file's text under the given path.
+    pub fn new(path: impl Into<PathBuf>, text: impl Into<Arc<str>>) -> Arc<Self> {
+        Arc::new(Self {
+            path: path.into(),
+            text: text.into(),
+        })
+    }
+
+    /// The directory holding this file, against which relative names inside it resolve.
+    pub fn dir(&self) -> &Path {
+        self.path.parent().unwrap_or_else(|| Path::new(""))
+    }
+}
+
+/// A place in a source file: a byte offset, turned into line and column on demand.
+///
+/// Columns are computed only when reporting, because computing them per token is quadratic on
+/// pbrt's long one-line arrays.
+#[derive(Clone)]
+pub struct Loc {
+    /// The file the location is in.
+    pub file: Arc<SourceFile>,
+    /// Byte offset from the start of the file.
+    pub offset: u32,
+}
+
+impl Loc {
+    /// A location at `offset` bytes into `file`.
+    pub fn new(file: &Arc<SourceFile>, offset: usize) -> Self {
+        Self {
+            file: Arc::clone(file),
+            offset: offset.min(u32::MAX as usize) as u32,
+        }
+    }
+
+    /// 1-based line and column (in characters) of this location.
+    pub fn line_col(&self) -> (usize, usize) {
+        let text = &self.file.text;
+        let offset = (self.offset as usize).min(text.len());
+        let before = &text.as_bytes()[..offset];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |p| p + 1);
+        let col = String::from_utf8_lossy(&before[line_start..]).chars().count() + 1;
+        (line, col)
+    }
+
+    /// The text of the line holding this location, without its line break, shortened around
+    /// the column when very long (pbrt files often hold a whole mesh on one line).
+    pub fn snippet(&self) -> String {
+        const MAX: usize = 120;
+        let text = &self.file.text;
+        let offset = (self.offset as usize).min(text.len());
+        let bytes = text.as_bytes();
+        let start = bytes[..offset]
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |p| p + 1);
+        let end = bytes[offset..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| offset + p);
+        let line = String::from_utf8_lossy(&bytes[start..end]);
+        let line = line.trim_end_matches('\r');
+        let chars: Vec<char> = line.chars().map(|c| if c == '\t' { ' ' } else { c }).collect();
+        let col = String::from_utf8_lossy(&bytes[start..offset]).chars().count();
+        let (from, prefix) = if col > MAX / 2 {
+            (col - MAX / 2, "...")
+        } else {
+            (0, "")
+        };
+        let to = (from + MAX).min(chars.len());
+        let suffix = if to < chars.len() { "..." } else { "" };
+        let shown: String = chars[from.min(to)..to].iter().collect();
+        let caret_at = prefix.len() + col - from;
+        format!(
+            "{prefix}{shown}{suffix}\n{:width$}^",
+            "",
+            width = caret_at
+        )
+    }
+}
+
+impl fmt::Display for Loc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (line, col) = self.line_col();
+        write!(f, "{}:{line}:{col}", self.file.path.display())
+    }
+}
+
+impl fmt::Debug for Loc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(self, f)
+    }
+}

@@ -1,0 +1,7 @@
+//! The `acr` binary.
+
+use clap::Parser;
+
+fn main() -> std::process::ExitCode {
+    acr::cli::run(acr::cli::Cli::parse())
+}
