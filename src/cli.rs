@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Adaptive cluster rendering for pbrt-v3 scenes.
@@ -26,17 +26,21 @@ pub enum Command {
 
 /// Runs the command line; returns the process exit code.
 pub fn run(cli: Cli) -> ExitCode {
-    match cli.command {
-        Command::Parse { scene } => match acr_parser::parse_file(&scene) {
-            Ok(desc) => {
-                let mut out = std::io::stdout().lock();
-                // A closed pipe (acr parse x | head) is not an error worth reporting.
-                let _ = out.write_all(desc.to_text().as_bytes());
-                ExitCode::SUCCESS
-            }
-            Err(e) => report(&e),
-        },
+    let result = match cli.command {
+        Command::Parse { scene } => parse(&scene),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => report(&e),
     }
+}
+
+fn parse(scene: &Path) -> Result<(), String> {
+    let desc = acr_parser::parse_file(scene).map_err(|e| e.to_string())?;
+    let mut out = std::io::stdout().lock();
+    // A closed pipe (acr parse x | head) is not an error worth reporting.
+    let _ = out.write_all(desc.to_text().as_bytes());
+    Ok(())
 }
 
 /// Prints an error the way every acr command does, and gives the failure exit code.

@@ -236,9 +236,9 @@ impl Builder {
                 ),
             ));
         };
-        for i in 0..2 {
-            if self.active[i] {
-                self.ctm[i] = saved[i];
+        for ((ctm, saved), active) in self.ctm.iter_mut().zip(saved).zip(self.active) {
+            if active {
+                *ctm = saved;
             }
         }
         Ok(())
@@ -539,7 +539,9 @@ impl Builder {
     fn add_material(&mut self, name: Option<String>, mut plugin: PluginDesc) -> Result<usize> {
         self.resolve_textures(&mut plugin.params)?;
         let mix = self.resolve_mix(&plugin)?;
-        self.scene.materials.push(MaterialDesc { name, plugin, mix });
+        self.scene
+            .materials
+            .push(MaterialDesc { name, plugin, mix });
         Ok(self.scene.materials.len() - 1)
     }
 
@@ -553,16 +555,17 @@ impl Builder {
         loc: Loc,
     ) -> Result<()> {
         self.require_world("Texture", &loc)?;
-        let value = match value {
-            "float" => TextureValue::Float,
-            "color" | "spectrum" | "rgb" => TextureValue::Spectrum,
-            other => {
-                return Err(Error::at(
+        let value =
+            match value {
+                "float" => TextureValue::Float,
+                "color" | "spectrum" | "rgb" => TextureValue::Spectrum,
+                other => return Err(Error::at(
                     &loc,
-                    format!("texture type must be \"float\" or \"color\"/\"spectrum\", not \"{other}\""),
-                ))
-            }
-        };
+                    format!(
+                        "texture type must be \"float\" or \"color\"/\"spectrum\", not \"{other}\""
+                    ),
+                )),
+            };
         self.resolve_textures(&mut params)?;
         let index = self.scene.textures.len();
         let table = match value {
@@ -619,7 +622,10 @@ impl Builder {
             }
             "Film" | "Sampler" | "PixelFilter" | "Integrator" | "Accelerator" => {
                 self.require_options(directive, &loc)?;
-                fn slot<'s>(s: &'s mut SceneDescription, directive: &str) -> &'s mut Option<PluginDesc> {
+                fn slot<'s>(
+                    s: &'s mut SceneDescription,
+                    directive: &str,
+                ) -> &'s mut Option<PluginDesc> {
                     match directive {
                         "Film" => &mut s.film,
                         "Sampler" => &mut s.sampler,
@@ -794,8 +800,12 @@ fn triangle_mesh(plugin: &PluginDesc) -> Result<Mesh> {
         Some(ix) => ix
             .iter()
             .map(|&i| {
-                u32::try_from(i)
-                    .map_err(|_| err_at("indices", format!("trianglemesh: negative vertex index {i}")))
+                u32::try_from(i).map_err(|_| {
+                    err_at(
+                        "indices",
+                        format!("trianglemesh: negative vertex index {i}"),
+                    )
+                })
             })
             .collect::<Result<_>>()?,
         // pbrt-v4 allows a single triangle without indices.
@@ -807,13 +817,11 @@ fn triangle_mesh(plugin: &PluginDesc) -> Result<Mesh> {
             ))
         }
     };
-    let normals = params
-        .numbers("N", ParamType::Normal)?
-        .map(|n| {
-            n.chunks_exact(3)
-                .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
-                .collect::<Vec<_>>()
-        });
+    let normals = params.numbers("N", ParamType::Normal)?.map(|n| {
+        n.chunks_exact(3)
+            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+            .collect::<Vec<_>>()
+    });
     let uv_param = ["uv", "st"].into_iter().find_map(|k| params.get(k));
     let uvs = match uv_param {
         Some(param) => match (&param.values, param.ty) {

@@ -57,11 +57,19 @@ impl SceneDescription {
         let files: Vec<String> = self.files.iter().map(|f| d.path(&f.path)).collect();
         wl(o, 0, format!("files: {}", files.join(", ")));
         let (t0, t1) = self.transform_times;
-        wl(o, 0, format!("transform times: {} {}", fmt_num(t0), fmt_num(t1)));
+        wl(
+            o,
+            0,
+            format!("transform times: {} {}", fmt_num(t0), fmt_num(t1)),
+        );
         match &self.camera {
             Some(c) => {
                 d.plugin(o, 0, "camera", &c.plugin);
-                wl(o, 1, format!("camera_from_world: {}", animated(&c.camera_from_world)));
+                wl(
+                    o,
+                    1,
+                    format!("camera_from_world: {}", animated(&c.camera_from_world)),
+                );
                 d.params(o, 1, &c.plugin);
             }
             None => wl(o, 0, "camera: none"),
@@ -102,14 +110,22 @@ impl SceneDescription {
             let head = format!("#{i} \"{}\" {:?}", t.name, t.value).to_lowercase();
             d.plugin(o, 1, &head, &t.plugin);
             if !t.world_from_texture.abs_diff_eq(DMat4::IDENTITY, DUST) {
-                wl(o, 2, format!("world_from_texture: {}", matrix(&t.world_from_texture)));
+                wl(
+                    o,
+                    2,
+                    format!("world_from_texture: {}", matrix(&t.world_from_texture)),
+                );
             }
             d.params(o, 2, &t.plugin);
         }
         wl(o, 0, format!("lights: {}", self.lights.len()));
         for (i, l) in self.lights.iter().enumerate() {
             d.plugin(o, 1, &format!("#{i}"), &l.plugin);
-            wl(o, 2, format!("world_from_light: {}", matrix(&l.world_from_light)));
+            wl(
+                o,
+                2,
+                format!("world_from_light: {}", matrix(&l.world_from_light)),
+            );
             d.params(o, 2, &l.plugin);
         }
         wl(o, 0, format!("shapes: {}", self.shapes.len()));
@@ -138,11 +154,21 @@ impl SceneDescription {
                 .get_index(inst.object)
                 .map_or("?", |(n, _)| n.as_str());
             wl(o, 1, format!("#{i} of \"{name}\" at {}", d.loc(&inst.loc)));
-            wl(o, 2, format!("world_from_instance: {}", animated(&inst.world_from_instance)));
+            wl(
+                o,
+                2,
+                format!(
+                    "world_from_instance: {}",
+                    animated(&inst.world_from_instance)
+                ),
+            );
         }
         wl(o, 0, format!("warnings: {}", self.warnings.len()));
         for w in &self.warnings {
-            let at = w.loc.as_ref().map_or(String::new(), |l| format!("{}: ", d.loc(l)));
+            let at = w
+                .loc
+                .as_ref()
+                .map_or(String::new(), |l| format!("{}: ", d.loc(l)));
             wl(o, 1, format!("{at}{}", w.message));
         }
         out
@@ -174,7 +200,11 @@ impl Dump<'_> {
     }
 
     fn plugin(&self, o: &mut String, indent: usize, head: &str, p: &PluginDesc) {
-        wl(o, indent, format!("{head} {} at {}", p.kind, self.loc(&p.loc)));
+        wl(
+            o,
+            indent,
+            format!("{head} {} at {}", p.kind, self.loc(&p.loc)),
+        );
     }
 
     fn params(&self, o: &mut String, indent: usize, p: &PluginDesc) {

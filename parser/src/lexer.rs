@@ -64,7 +64,11 @@ impl Tokenizer {
     /// A tokenizer at the start of `file`.
     pub fn new(file: Arc<SourceFile>) -> Self {
         // A UTF-8 byte order mark is not part of the scene.
-        let pos = if file.text.starts_with('\u{feff}') { 3 } else { 0 };
+        let pos = if file.text.starts_with('\u{feff}') {
+            3
+        } else {
+            0
+        };
         Self { file, pos }
     }
 
@@ -132,9 +136,8 @@ impl Tokenizer {
         let mut value = String::new();
         let mut input = &rest[1..];
         loop {
-            let (after, run) = plain_run(input).map_err(|_| {
-                Error::at(&self.loc(start), "unterminated string")
-            })?;
+            let (after, run) =
+                plain_run(input).map_err(|_| Error::at(&self.loc(start), "unterminated string"))?;
             value.push_str(run);
             let mut chars = after.chars();
             match chars.next() {
@@ -157,9 +160,7 @@ impl Tokenizer {
                                 format!("unknown escape sequence \\{c} in string"),
                             ));
                         }
-                        None => {
-                            return Err(Error::at(&self.loc(start), "unterminated string"))
-                        }
+                        None => return Err(Error::at(&self.loc(start), "unterminated string")),
                     };
                     value.push(escaped);
                     input = chars.as_str();

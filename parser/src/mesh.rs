@@ -41,7 +41,10 @@ impl Mesh {
         }
         if let Some(normals) = &self.normals {
             if normals.len() != n {
-                return Err(format!("mesh has {} normals for {n} vertices", normals.len()));
+                return Err(format!(
+                    "mesh has {} normals for {n} vertices",
+                    normals.len()
+                ));
             }
         }
         if let Some(uvs) = &self.uvs {
@@ -49,7 +52,11 @@ impl Mesh {
                 return Err(format!("mesh has {} uvs for {n} vertices", uvs.len()));
             }
         }
-        if let Some(p) = self.positions.iter().find(|p| !p.iter().all(|c| c.is_finite())) {
+        if let Some(p) = self
+            .positions
+            .iter()
+            .find(|p| !p.iter().all(|c| c.is_finite()))
+        {
             return Err(format!("vertex position {p:?} is not finite"));
         }
         Ok(())

@@ -261,7 +261,9 @@ impl ParamList {
 
     /// A single float (an integer value is not accepted: pbrt declares types explicitly).
     pub fn float(&self, name: &str) -> Result<Option<f64>> {
-        self.get(name).map(|p| p.one(self.float_values(p)?)).transpose()
+        self.get(name)
+            .map(|p| p.one(self.float_values(p)?))
+            .transpose()
     }
 
     /// A float with a default.
@@ -283,7 +285,9 @@ impl ParamList {
 
     /// A single integer.
     pub fn int(&self, name: &str) -> Result<Option<i32>> {
-        self.get(name).map(|p| p.one(Self::int_values(p)?)).transpose()
+        self.get(name)
+            .map(|p| p.one(Self::int_values(p)?))
+            .transpose()
     }
 
     /// An integer with a default.
@@ -326,7 +330,11 @@ impl ParamList {
                     [s] => Ok(s.as_str()),
                     _ => Err(Error::at(
                         &p.loc,
-                        format!("parameter \"{}\" needs one string, found {}", p.name, v.len()),
+                        format!(
+                            "parameter \"{}\" needs one string, found {}",
+                            p.name,
+                            v.len()
+                        ),
                     )),
                 },
                 _ => Err(p.wrong_type("string")),
@@ -356,7 +364,11 @@ impl ParamList {
                 Err(match p {
                     Some(loc) => Error::at(
                         &loc,
-                        format!("parameter \"{name}\" needs one {}, found {}", ty.name(), v.len() / 3),
+                        format!(
+                            "parameter \"{name}\" needs one {}, found {}",
+                            ty.name(),
+                            v.len() / 3
+                        ),
                     ),
                     None => Error::file("", "internal: parameter vanished"),
                 })

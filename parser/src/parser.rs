@@ -129,7 +129,12 @@ pub(crate) fn resolve_path(name: &str, including: &SourceFile, base_dir: &Path) 
 pub fn closest<'a>(name: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     known
         .into_iter()
-        .map(|k| (strsim::damerau_levenshtein(&name.to_lowercase(), &k.to_lowercase()), k))
+        .map(|k| {
+            (
+                strsim::damerau_levenshtein(&name.to_lowercase(), &k.to_lowercase()),
+                k,
+            )
+        })
         .filter(|&(d, k)| d <= 2.max(k.len() / 3))
         .min_by_key(|&(d, _)| d)
         .map(|(_, k)| k)
@@ -170,12 +175,6 @@ impl Parser {
 
     fn loc(&self, offset: usize) -> Loc {
         Loc::new(self.file(), offset)
-    }
-
-    /// Where the end of the current file is, for "ended early" errors.
-    fn end_loc(&self) -> Loc {
-        let file = self.file();
-        Loc::new(file, file.text.len())
     }
 
     fn peek(&mut self) -> Result<Option<&Token>> {
@@ -238,7 +237,8 @@ impl Parser {
             }
             "Translate" => {
                 let v = self.numbers::<3>(name, &loc)?;
-                self.builder.concat(crate::transform::translate(DVec3::from(v)));
+                self.builder
+                    .concat(crate::transform::translate(DVec3::from(v)));
                 Ok(())
             }
             "Scale" => {
@@ -344,10 +344,17 @@ impl Parser {
             }
             "MediumInterface" => {
                 self.string_arg(name, &loc)?;
-                if matches!(self.peek()?, Some(Token { kind: TokenKind::Str(_), .. })) {
+                if matches!(
+                    self.peek()?,
+                    Some(Token {
+                        kind: TokenKind::Str(_),
+                        ..
+                    })
+                ) {
                     self.next()?;
                 }
-                self.builder.unsupported_once(name, &loc, "participating media");
+                self.builder
+                    .unsupported_once(name, &loc, "participating media");
                 Ok(())
             }
             "Include" => {
@@ -374,11 +381,14 @@ impl Parser {
             ));
         }
         let path = resolve_path(name, self.file(), &self.base_dir);
-        let text = std::fs::read(&path)
-            .map_err(|e| Error::at(loc, format!("cannot read included file \"{name}\": {}", io_message(&e))))?;
-        let text = String::from_utf8(text).map_err(|_| {
-            Error::at(loc, format!("included file \"{name}\" is not UTF-8 text"))
+        let text = std::fs::read(&path).map_err(|e| {
+            Error::at(
+                loc,
+                format!("cannot read included file \"{name}\": {}", io_message(&e)),
+            )
         })?;
+        let text = String::from_utf8(text)
+            .map_err(|_| Error::at(loc, format!("included file \"{name}\" is not UTF-8 text")))?;
         let file = SourceFile::new(path, text);
         self.builder.add_file(Arc::clone(&file));
         self.stack.push(Tokenizer::new(file));
@@ -394,7 +404,10 @@ impl Parser {
             }) => Ok(s),
             Some(t) => Err(Error::at(
                 &self.loc(t.offset),
-                format!("{directive} expects a quoted string here, found {}", describe(&t.kind)),
+                format!(
+                    "{directive} expects a quoted string here, found {}",
+                    describe(&t.kind)
+                ),
             )),
             None => Err(Error::at(
                 loc,
@@ -405,7 +418,13 @@ impl Parser {
 
     /// Exactly `N` numbers, with or without brackets around them.
     fn numbers<const N: usize>(&mut self, directive: &str, loc: &Loc) -> Result<[f64; N]> {
-        let bracketed = matches!(self.peek()?, Some(Token { kind: TokenKind::Open, .. }));
+        let bracketed = matches!(
+            self.peek()?,
+            Some(Token {
+                kind: TokenKind::Open,
+                ..
+            })
+        );
         if bracketed {
             self.next()?;
         }
@@ -417,8 +436,11 @@ impl Parser {
                     ..
                 }) => *slot = v,
                 other => {
-                    let at = other.as_ref().map_or_else(|| self.end_loc(), |t| self.loc(t.offset));
-                    let found = other.map_or("the end of the file".to_owned(), |t| describe(&t.kind));
+                    let at = other
+                        .as_ref()
+                        .map_or_else(|| loc.clone(), |t| self.loc(t.offset));
+                    let found =
+                        other.map_or("the end of the file".to_owned(), |t| describe(&t.kind));
                     return Err(Error::at(
                         &at,
                         format!("{directive} expects {N} numbers, found {found} after {i}"),
@@ -433,7 +455,9 @@ impl Parser {
                     ..
                 }) => {}
                 other => {
-                    let at = other.as_ref().map_or_else(|| loc.clone(), |t| self.loc(t.offset));
+                    let at = other
+                        .as_ref()
+                        .map_or_else(|| loc.clone(), |t| self.loc(t.offset));
                     return Err(Error::at(
                         &at,
                         format!("{directive} expects exactly {N} numbers followed by ']'"),
@@ -464,7 +488,10 @@ impl Parser {
             if let Some(old) = list.push(param) {
                 self.builder.warn(
                     &old.loc,
-                    format!("parameter \"{}\" is given again later; the later one is used", old.name),
+                    format!(
+                        "parameter \"{}\" is given again later; the later one is used",
+                        old.name
+                    ),
                 );
             }
         }
@@ -481,8 +508,22 @@ impl Parser {
         };
         let ty = ParamType::from_name(ty_name).ok_or_else(|| {
             const TYPES: &[&str] = &[
-                "integer", "float", "point2", "vector2", "point3", "vector3", "normal3", "point",
-                "vector", "normal", "rgb", "color", "spectrum", "blackbody", "bool", "string",
+                "integer",
+                "float",
+                "point2",
+                "vector2",
+                "point3",
+                "vector3",
+                "normal3",
+                "point",
+                "vector",
+                "normal",
+                "rgb",
+                "color",
+                "spectrum",
+                "blackbody",
+                "bool",
+                "string",
                 "texture",
             ];
             Error::at(
@@ -520,10 +561,12 @@ impl Parser {
                     }
                 }
             },
-            Some(t @ Token {
-                kind: TokenKind::Number(_) | TokenKind::Str(_) | TokenKind::Word(_),
-                ..
-            }) => {
+            Some(
+                t @ Token {
+                    kind: TokenKind::Number(_) | TokenKind::Str(_) | TokenKind::Word(_),
+                    ..
+                },
+            ) => {
                 if matches!(&t.kind, TokenKind::Word(w) if w != "true" && w != "false") {
                     return Err(Error::at(
                         &self.loc(t.offset),
@@ -535,7 +578,10 @@ impl Parser {
             Some(t) => {
                 return Err(Error::at(
                     &self.loc(t.offset),
-                    format!("expected a value for parameter \"{name}\", found {}", describe(&t.kind)),
+                    format!(
+                        "expected a value for parameter \"{name}\", found {}",
+                        describe(&t.kind)
+                    ),
                 ))
             }
             None => {
@@ -560,33 +606,38 @@ struct Raw {
 
 impl Raw {
     fn push(&mut self, t: Token, file: &Arc<SourceFile>, name: &str) -> Result<()> {
-        let kind_name = match t.kind {
-            TokenKind::Number(v) => {
-                self.numbers.push(v);
-                "number"
-            }
-            TokenKind::Str(s) => {
-                self.strings.push(s);
-                "string"
-            }
-            TokenKind::Word(w) if w == "true" || w == "false" => {
-                self.bools.push(w == "true");
-                "bool"
-            }
-            TokenKind::Word(w) => {
-                return Err(Error::at(
+        let kind_name =
+            match t.kind {
+                TokenKind::Number(v) => {
+                    self.numbers.push(v);
+                    "number"
+                }
+                TokenKind::Str(s) => {
+                    self.strings.push(s);
+                    "string"
+                }
+                TokenKind::Word(w) if w == "true" || w == "false" => {
+                    self.bools.push(w == "true");
+                    "bool"
+                }
+                TokenKind::Word(w) => return Err(Error::at(
                     &Loc::new(file, t.offset),
-                    format!("parameter \"{name}\": unexpected '{w}' among its values (missing ']'?)"),
-                ))
-            }
-            TokenKind::Open | TokenKind::Close => {
-                return Err(Error::at(
-                    &Loc::new(file, t.offset),
-                    format!("parameter \"{name}\": unexpected bracket among its values"),
-                ))
-            }
-        };
-        let kinds = [!self.numbers.is_empty(), !self.strings.is_empty(), !self.bools.is_empty()];
+                    format!(
+                        "parameter \"{name}\": unexpected '{w}' among its values (missing ']'?)"
+                    ),
+                )),
+                TokenKind::Open | TokenKind::Close => {
+                    return Err(Error::at(
+                        &Loc::new(file, t.offset),
+                        format!("parameter \"{name}\": unexpected bracket among its values"),
+                    ))
+                }
+            };
+        let kinds = [
+            !self.numbers.is_empty(),
+            !self.strings.is_empty(),
+            !self.bools.is_empty(),
+        ];
         if kinds.iter().filter(|&&k| k).count() > 1 {
             return Err(Error::at(
                 &Loc::new(file, t.offset),

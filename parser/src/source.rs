@@ -59,7 +59,10 @@ impl Loc {
             .iter()
             .rposition(|&b| b == b'\n')
             .map_or(0, |p| p + 1);
-        let col = String::from_utf8_lossy(&before[line_start..]).chars().count() + 1;
+        let col = String::from_utf8_lossy(&before[line_start..])
+            .chars()
+            .count()
+            + 1;
         (line, col)
     }
 
@@ -80,8 +83,13 @@ impl Loc {
             .map_or(bytes.len(), |p| offset + p);
         let line = String::from_utf8_lossy(&bytes[start..end]);
         let line = line.trim_end_matches('\r');
-        let chars: Vec<char> = line.chars().map(|c| if c == '\t' { ' ' } else { c }).collect();
-        let col = String::from_utf8_lossy(&bytes[start..offset]).chars().count();
+        let chars: Vec<char> = line
+            .chars()
+            .map(|c| if c == '\t' { ' ' } else { c })
+            .collect();
+        let col = String::from_utf8_lossy(&bytes[start..offset])
+            .chars()
+            .count();
         let (from, prefix) = if col > MAX / 2 {
             (col - MAX / 2, "...")
         } else {
@@ -91,11 +99,7 @@ impl Loc {
         let suffix = if to < chars.len() { "..." } else { "" };
         let shown: String = chars[from.min(to)..to].iter().collect();
         let caret_at = prefix.len() + col - from;
-        format!(
-            "{prefix}{shown}{suffix}\n{:width$}^",
-            "",
-            width = caret_at
-        )
+        format!("{prefix}{shown}{suffix}\n{:width$}^", "", width = caret_at)
     }
 }
 

@@ -79,7 +79,12 @@ mod tests {
 
     #[test]
     fn look_at_puts_target_on_plus_z() {
-        let m = look_at(DVec3::new(0.0, 1.0, 5.0), DVec3::new(0.0, 1.0, 0.0), DVec3::Y).unwrap();
+        let m = look_at(
+            DVec3::new(0.0, 1.0, 5.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::Y,
+        )
+        .unwrap();
         let t = m.transform_point3(DVec3::new(0.0, 1.0, 0.0));
         assert!((t - DVec3::new(0.0, 0.0, 5.0)).length() < 1e-12, "{t}");
         // Left-handed camera space: world +x (to the camera's left when it looks down -z)

@@ -1,0 +1,360 @@
+//! The graphics state's semantics, checked on small inline scenes.
+
+use acr_parser::{parse_str, ParamType, SceneDescription};
+use glam::{DMat4, DVec3};
+use std::path::Path;
+
+fn parse(text: &str) -> SceneDescription {
+    parse_str(text, Path::new("test.pbrt")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn err(text: &str) -> String {
+    match parse_str(text, Path::new("test.pbrt")) {
+        Ok(_) => panic!("expected an error for:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-9
+}
+
+fn point(m: &DMat4, p: [f64; 3]) -> DVec3 {
+    m.transform_point3(DVec3::from(p))
+}
+
+#[test]
+fn transforms_compose_on_the_right_as_in_pbrt() {
+    let d = parse(
+        "WorldBegin\nTranslate 1 0 0\nScale 2 2 2\nRotate 90 0 0 1\nShape \"sphere\"\nWorldEnd\n",
+    );
+    let m = d.shapes[0].world_from_object.start;
+    // Rotate first (innermost), then scale, then translate.
+    assert!(close(point(&m, [1.0, 0.0, 0.0]), DVec3::new(1.0, 2.0, 0.0)));
+    assert!(!d.shapes[0].world_from_object.is_animated());
+}
+
+#[test]
+fn transform_and_concat_transform_are_column_major_like_pbrt() {
+    let d = parse(
+        "WorldBegin\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\n\
+         ConcatTransform [2 0 0 0  0 2 0 0  0 0 2 0  0 0 0 1]\nShape \"sphere\"\nWorldEnd",
+    );
+    let m = d.shapes[0].world_from_object.start;
+    assert!(close(point(&m, [1.0, 1.0, 1.0]), DVec3::new(7.0, 8.0, 9.0)));
+}
+
+#[test]
+fn attribute_blocks_restore_transform_material_and_orientation() {
+    let d = parse(
+        "WorldBegin\nMaterial \"plastic\"\nAttributeBegin\nTranslate 0 5 0\nMaterial \"mirror\"\n\
+         ReverseOrientation\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n\
+         TransformBegin\nTranslate 1 0 0\nMaterial \"glass\"\nTransformEnd\nShape \"disk\"\nWorldEnd",
+    );
+    let [a, b, c] = &d.shapes[..] else { panic!() };
+    assert_eq!(d.materials[a.material.unwrap()].plugin.kind, "mirror");
+    assert!(a.reverse_orientation);
+    assert!(close(
+        point(&a.world_from_object.start, [0.0; 3]),
+        DVec3::new(0.0, 5.0, 0.0)
+    ));
+    assert_eq!(d.materials[b.material.unwrap()].plugin.kind, "plastic");
+    assert!(!b.reverse_orientation);
+    assert_eq!(b.world_from_object.start, DMat4::IDENTITY);
+    // TransformEnd restores the transform but not the material.
+    assert_eq!(c.world_from_object.start, DMat4::IDENTITY);
+    assert_eq!(d.materials[c.material.unwrap()].plugin.kind, "glass");
+}
+
+#[test]
+fn default_material_and_none() {
+    let d = parse("WorldBegin\nShape \"sphere\"\nMaterial \"\"\nShape \"sphere\"\nWorldEnd");
+    assert_eq!(d.shapes[0].material, Some(0));
+    assert_eq!(d.materials[0].plugin.kind, "matte");
+    assert_eq!(d.shapes[1].material, None);
+}
+
+#[test]
+fn motion_uses_active_transform_and_transform_times() {
+    let d = parse(
+        "TransformTimes 0.25 0.75\nWorldBegin\nTranslate 1 0 0\nActiveTransform EndTime\n\
+         Translate 0 2 0\nActiveTransform StartTime\nScale 3 3 3\nActiveTransform All\n\
+         Shape \"sphere\"\nShape \"disk\"\nWorldEnd",
+    );
+    let t = d.shapes[0].world_from_object;
+    assert!(t.is_animated());
+    assert_eq!((t.start_time, t.end_time), (0.25, 0.75));
+    assert!(close(
+        point(&t.start, [1.0, 0.0, 0.0]),
+        DVec3::new(4.0, 0.0, 0.0)
+    ));
+    assert!(close(
+        point(&t.end, [1.0, 0.0, 0.0]),
+        DVec3::new(2.0, 2.0, 0.0)
+    ));
+}
+
+#[test]
+fn camera_transform_and_named_camera_space() {
+    let d = parse(
+        "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\n\
+         AttributeBegin\nCoordSysTransform \"camera\"\nLightSource \"point\"\nAttributeEnd\nWorldEnd",
+    );
+    let cam = d.camera.as_ref().unwrap();
+    assert_eq!(cam.plugin.params.float("fov").unwrap(), Some(45.0));
+    // The camera's origin in world space is its position.
+    let world_from_camera = cam.camera_from_world.start.inverse();
+    assert!(close(
+        point(&world_from_camera, [0.0; 3]),
+        DVec3::new(0.0, 0.0, 5.0)
+    ));
+    // A light placed in camera space sits at the camera.
+    let l = d.lights[0].world_from_light;
+    assert!(close(point(&l, [0.0; 3]), DVec3::new(0.0, 0.0, 5.0)));
+}
+
+#[test]
+fn named_materials_are_scoped_and_mix_resolves() {
+    let d = parse(
+        "WorldBegin\nMakeNamedMaterial \"red\" \"string type\" \"matte\" \"rgb Kd\" [1 0 0]\n\
+         AttributeBegin\nMakeNamedMaterial \"blue\" \"string type\" \"matte\" \"rgb Kd\" [0 0 1]\n\
+         MakeNamedMaterial \"both\" \"string type\" \"mix\" \"string namedmaterial1\" \"red\"\n\
+         \"string namedmaterial2\" \"blue\"\nNamedMaterial \"both\"\nShape \"sphere\"\nAttributeEnd\n\
+         NamedMaterial \"red\"\nShape \"sphere\"\nWorldEnd",
+    );
+    let mix = &d.materials[d.shapes[0].material.unwrap()];
+    assert_eq!(mix.plugin.kind, "mix");
+    let [a, b] = mix.mix.unwrap();
+    assert_eq!(d.materials[a].name.as_deref(), Some("red"));
+    assert_eq!(d.materials[b].name.as_deref(), Some("blue"));
+    assert_eq!(
+        d.materials[d.shapes[1].material.unwrap()].name.as_deref(),
+        Some("red")
+    );
+    // "blue" went out of scope with its attribute block.
+    let e = err(
+        "WorldBegin\nAttributeBegin\nMakeNamedMaterial \"blue\" \"string type\" \"matte\"\n\
+                 AttributeEnd\nNamedMaterial \"blue\"\nWorldEnd",
+    );
+    assert!(e.contains("no material named \"blue\""), "{e}");
+}
+
+#[test]
+fn textures_resolve_by_kind_and_scope() {
+    let d = parse(
+        "WorldBegin\nTexture \"c\" \"color\" \"checkerboard\" \"float uscale\" 4\n\
+         Texture \"f\" \"float\" \"constant\" \"float value\" 0.5\n\
+         Texture \"s\" \"color\" \"scale\" \"texture tex1\" \"c\" \"texture tex2\" \"f\"\n\
+         Material \"matte\" \"texture Kd\" \"s\" \"texture sigma\" \"f\"\nShape \"sphere\"\nWorldEnd",
+    );
+    let m = &d.materials[1];
+    let kd = m.plugin.params.texture("Kd").unwrap();
+    assert_eq!((kd.spectrum, kd.float), (Some(2), None));
+    let sigma = m.plugin.params.texture("sigma").unwrap();
+    assert_eq!((sigma.spectrum, sigma.float), (None, Some(1)));
+    let scale = &d.textures[2].plugin.params;
+    assert_eq!(scale.texture("tex1").unwrap().spectrum, Some(0));
+    let e = err("WorldBegin\nMaterial \"matte\" \"texture Kd\" \"nope\"\nWorldEnd");
+    assert!(
+        e.contains("test.pbrt:2:18: no texture named \"nope\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn object_instances_share_one_definition() {
+    let d = parse(
+        "WorldBegin\nObjectBegin \"tri\"\nTranslate 0 0 1\nShape \"trianglemesh\" \
+         \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\nObjectEnd\n\
+         Translate 5 0 0\nObjectInstance \"tri\"\nTranslate 5 0 0\nObjectInstance \"tri\"\nWorldEnd",
+    );
+    assert!(d.shapes.is_empty());
+    assert_eq!(d.objects.len(), 1);
+    assert_eq!(d.objects["tri"].shapes.len(), 1);
+    assert_eq!(d.instances.len(), 2);
+    let inst = &d.instances[1];
+    assert!(close(
+        point(&inst.world_from_instance.start, [0.0; 3]),
+        DVec3::new(10.0, 0.0, 0.0)
+    ));
+    // The transform inside the definition stays on the shape; ObjectEnd restored the outer one.
+    let s = &d.objects["tri"].shapes[0];
+    assert!(close(
+        point(&s.world_from_object.start, [0.0; 3]),
+        DVec3::new(0.0, 0.0, 1.0)
+    ));
+    assert!(close(
+        point(&d.instances[0].world_from_instance.start, [0.0; 3]),
+        DVec3::new(5.0, 0.0, 0.0)
+    ));
+}
+
+#[test]
+fn area_lights_attach_to_shapes_in_scope() {
+    let d = parse(
+        "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 3]\n\
+         Shape \"sphere\"\nShape \"disk\"\nAttributeEnd\nShape \"sphere\"\nWorldEnd",
+    );
+    assert!(d.shapes[0].area_light.is_some());
+    assert!(d.shapes[1].area_light.is_some());
+    assert!(d.shapes[2].area_light.is_none());
+    let l = d.shapes[0].area_light.as_ref().unwrap();
+    assert_eq!(
+        l.params.vec3("L", ParamType::Rgb).unwrap(),
+        Some([1.0, 2.0, 3.0])
+    );
+}
+
+#[test]
+fn parameter_types_and_single_values() {
+    let d = parse(
+        "Film \"image\" \"integer xresolution\" 64 \"string filename\" \"a \\\"b\\\".exr\"\n\
+         Sampler \"halton\" \"bool flag\" \"true\" \"bool other\" false\nWorldBegin\n\
+         LightSource \"distant\" \"point from\" [0 1 0] \"color L\" [1 1 1] \
+         \"blackbody I\" [6500 1] \"spectrum s\" [300 1 800 1]\nWorldEnd",
+    );
+    let film = d.film.as_ref().unwrap();
+    assert_eq!(film.params.int("xresolution").unwrap(), Some(64));
+    assert_eq!(film.params.string("filename").unwrap(), Some("a \"b\".exr"));
+    let s = d.sampler.as_ref().unwrap();
+    assert_eq!(s.params.bool("flag").unwrap(), Some(true));
+    assert_eq!(s.params.bool("other").unwrap(), Some(false));
+    let l = &d.lights[0].plugin.params;
+    assert_eq!(
+        l.vec3("from", ParamType::Point3).unwrap(),
+        Some([0.0, 1.0, 0.0])
+    );
+    assert_eq!(
+        l.numbers("I", ParamType::Blackbody).unwrap().unwrap().len(),
+        2
+    );
+    // Asking for the wrong type is an error that names the declared type.
+    let e = film.params.float("xresolution").unwrap_err().to_string();
+    assert!(e.contains("declared integer"), "{e}");
+}
+
+#[test]
+fn unused_parameters_are_reported_with_their_location() {
+    let d = parse("Camera \"perspective\" \"float fvo\" 45 \"float fov\" 30\nWorldBegin\nWorldEnd");
+    let cam = &d.camera.as_ref().unwrap().plugin.params;
+    assert_eq!(cam.float("fov").unwrap(), Some(30.0));
+    let w = d.unused_parameter_warnings();
+    assert_eq!(w.len(), 1);
+    assert_eq!(
+        w[0].to_string(),
+        "test.pbrt:1:22: warning: parameter \"float fvo\" of perspective was not used"
+    );
+}
+
+#[test]
+fn hundred_thousand_nested_attribute_blocks() {
+    let n = 100_000;
+    let mut text = String::from("WorldBegin\n");
+    text.push_str(&"AttributeBegin\n".repeat(n));
+    text.push_str("Translate 1 0 0\nShape \"sphere\"\n");
+    text.push_str(&"AttributeEnd\n".repeat(n));
+    text.push_str("Shape \"sphere\"\nWorldEnd\n");
+    let d = parse(&text);
+    assert_eq!(d.shapes.len(), 2);
+    assert_eq!(d.shapes[1].world_from_object.start, DMat4::IDENTITY);
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+}
+
+#[test]
+fn long_one_line_mesh_parses() {
+    // About 12 MB on a single line: pbrt exporters write meshes this way.
+    let n = 400_000;
+    let mut text = String::from("WorldBegin Shape \"trianglemesh\" \"point3 P\" [");
+    for i in 0..n {
+        let x = i as f64 * 0.001;
+        text.push_str(&format!("{x:.4} 0.1234 {:.4} ", 1.0 - x));
+    }
+    text.push_str("] \"integer indices\" [");
+    for i in 0..n - 2 {
+        text.push_str(&format!("{} {} {} ", i, i + 1, i + 2));
+    }
+    text.push_str("] WorldEnd");
+    assert!(text.len() > 12_000_000, "{}", text.len());
+    let d = parse(&text);
+    let mesh = d.shapes[0].mesh.as_ref().unwrap();
+    assert_eq!(mesh.positions.len(), n);
+    assert_eq!(mesh.triangle_count(), n - 2);
+}
+
+#[test]
+fn structural_errors() {
+    for (text, want) in [
+        ("Shape \"sphere\"", "test.pbrt:1:1: Shape is only allowed between WorldBegin and WorldEnd"),
+        ("WorldBegin\nCamera \"perspective\"", "test.pbrt:2:1: Camera must come before WorldBegin"),
+        ("WorldBegin\nAttributeEnd", "AttributeEnd without a matching AttributeBegin"),
+        ("WorldBegin\nAttributeBegin\nTransformEnd", "TransformEnd closes the AttributeBegin at test.pbrt:2:1"),
+        ("WorldBegin\nWorldEnd\nShape \"sphere\"", "Shape after WorldEnd"),
+        ("WorldBegin\nObjectInstance \"x\"", "no object named \"x\""),
+        ("WorldBegin\nObjectBegin \"a\"\nObjectBegin \"b\"", "inside the definition of \"a\""),
+        ("Rotate 10 0 0 0", "zero-length axis"),
+        ("LookAt 0 0 0 0 0 0 0 1 0", "LookAt"),
+        ("Translate 1 2", "Translate expects 3 numbers, found the end of the file after 2"),
+        ("CoordSysTransform \"camra\"", "no coordinate system named \"camra\""),
+        ("ActiveTransform Sometimes", "not 'Sometimes'"),
+        ("WorldBegin\nWorldBegin", "WorldBegin appears twice"),
+        ("WorldBegin\nMakeNamedMaterial \"m\" \"rgb Kd\" [1 1 1]", "needs a \"string type\""),
+        ("WorldBegin\nMaterial \"mix\" \"string namedmaterial1\" \"a\"", "no material named \"a\""),
+        ("\"float fov\" 3", "expected a directive, found string \"float fov\""),
+        ("Camera \"perspective\" \"float fov\" [ 1 2", "'[' is never closed"),
+        ("Camera \"perspective\" \"flaot fov\" 1", "unknown parameter type 'flaot' (did you mean float?)"),
+        ("Camera \"perspective\" \"float\" 1", "expected a parameter declaration"),
+        ("Camera \"perspective\" \"integer n\" 1.5", "1.5 is not a 32-bit integer"),
+        ("Camera \"perspective\" \"float fov\" \"wide\"", "declared float but has string values"),
+        ("Camera \"perspective\" \"point3 p\" [1 2]", "not a multiple of 3"),
+        ("Camera \"perspective\" \"bool b\" \"yes\"", "\"yes\" is not \"true\" or \"false\""),
+        ("Camera \"perspective\" \"float fov\" [1 \"a\"]", "mixes strings"),
+        ("Camera \"perspective\" \"float fov\" Shape", "has no value"),
+        ("Shpae \"sphere\"", "unknown directive 'Shpae' (did you mean Shape?)"),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 3]",
+         "test.pbrt:2:53: trianglemesh: vertex index 3 (index #2) is out of range: the mesh has 3 vertices"),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1] \"integer indices\" [0 1 2 3]",
+         "not a multiple of 3"),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1]", "needs an \"integer indices\""),
+        ("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"float uv\" [0 0 1 1]", "4 \"uv\" values for 3 vertices"),
+        ("WorldBegin\nShape \"plymesh\" \"string filename\" \"missing.ply\"", "cannot read PLY file \"missing.ply\": no such file"),
+        ("Include \"missing.pbrt\"", "test.pbrt:1:1: cannot read included file \"missing.pbrt\": no such file"),
+    ] {
+        let e = err(text);
+        assert!(e.contains(want), "for {text:?}\n got: {e}\nwant: {want}");
+    }
+}
+
+#[test]
+fn error_shows_line_and_caret() {
+    let e = err("WorldBegin\n  Shape \"sphere\" \"float radius\" [ 1 ] \"flot r\" 2\nWorldEnd");
+    assert_eq!(
+        e,
+        "test.pbrt:2:39: unknown parameter type 'flot' (did you mean float?)\n  \
+         Shape \"sphere\" \"float radius\" [ 1 ] \"flot r\" 2\n                                      ^"
+    );
+}
+
+#[test]
+fn garbage_never_panics() {
+    // Every prefix of a realistic scene, and some noise, gives Ok or a located error.
+    let scene = "LookAt 0 0 5 0 0 0 0 1 0 Camera \"perspective\" \"float fov\" [45]\n\
+                 WorldBegin AttributeBegin Material \"matte\" \"rgb Kd\" [.5 .5 .5]\n\
+                 Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n\
+                 AttributeEnd WorldEnd\n";
+    for end in 0..=scene.len() {
+        let _ = parse_str(&scene[..end], Path::new("t.pbrt"));
+    }
+    for noise in [
+        "\u{0}\u{1}",
+        "[[[[",
+        "]]]",
+        "\"",
+        "#",
+        "-",
+        "+.e",
+        "\u{feff}WorldBegin",
+        "é",
+    ] {
+        let _ = parse_str(noise, Path::new("t.pbrt"));
+    }
+}

@@ -1,0 +1,204 @@
+//! Rays, frames, surface interactions and robust ray spawning.
+
+pub use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
+
+/// Linear RGB radiance or reflectance.
+pub type Spectrum = Vec3;
+
+/// A ray with a time (for motion blur). Its extent is kept by the caller.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub o: Vec3,
+    /// Direction (not necessarily normalised).
+    pub d: Vec3,
+    /// Time within the shutter interval, in scene time units.
+    pub time: f32,
+}
+
+impl Ray {
+    /// A ray from `o` along `d` at `time`.
+    pub fn new(o: Vec3, d: Vec3, time: f32) -> Self {
+        Self { o, d, time }
+    }
+
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.o + self.d * t
+    }
+}
+
+/// An orthonormal frame: local z is `n`.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// Local x.
+    pub s: Vec3,
+    /// Local y.
+    pub t: Vec3,
+    /// Local z.
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// A frame around unit `n` (Duff et al. 2017, branchless and continuous almost everywhere).
+    pub fn from_z(n: Vec3) -> Self {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Self { s, t, n }
+    }
+
+    /// A frame with z = unit `n` and x as close as possible to `s` (Gram-Schmidt); falls back to
+    /// [`Frame::from_z`] when `s` is parallel to `n` or degenerate.
+    pub fn from_xz(s: Vec3, n: Vec3) -> Self {
+        let s = (s - n * n.dot(s)).normalize_or_zero();
+        if s == Vec3::ZERO || !s.is_finite() {
+            return Self::from_z(n);
+        }
+        Self {
+            s,
+            t: n.cross(s),
+            n,
+        }
+    }
+
+    /// World to local.
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    /// Local to world.
+    #[inline]
+    pub fn from_local(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// Where a ray meets a surface, with pbrt's differential geometry.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceInteraction {
+    /// The hit point.
+    pub p: Vec3,
+    /// Unit geometric normal, on the side pbrt orients it (flipped by ReverseOrientation and by
+    /// handedness-changing transforms).
+    pub n: Vec3,
+    /// Surface parameters.
+    pub uv: Vec2,
+    /// dp/du.
+    pub dpdu: Vec3,
+    /// dp/dv.
+    pub dpdv: Vec3,
+    /// Unit shading normal (interpolated vertex normals), on the same side as `n`.
+    pub shading_n: Vec3,
+    /// Shading dp/du (the tangent the BSDF frame is aligned with).
+    pub shading_dpdu: Vec3,
+    /// Unit direction towards where the ray came from (-ray.d normalised).
+    pub wo: Vec3,
+    /// The ray's time.
+    pub time: f32,
+}
+
+/// Offsets a point off a surface so that a ray leaving it does not hit that surface again.
+/// Wächter and Binder, "A Fast and Robust Method for Avoiding Self-Intersection" (Ray Tracing
+/// Gems, ch. 6): an offset of a fixed number of ulps along the normal, which scales with the
+/// point's magnitude and so stays safe far from the origin; near the origin, a small absolute
+/// offset instead.
+#[inline]
+pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let of_i = (n * INT_SCALE).as_ivec3();
+    let bump = |p: f32, o: i32| -> f32 {
+        let bits = p.to_bits() as i32;
+        f32::from_bits((bits + if p < 0.0 { -o } else { o }) as u32)
+    };
+    let p_i = Vec3::new(bump(p.x, of_i.x), bump(p.y, of_i.y), bump(p.z, of_i.z));
+    Vec3::new(
+        if p.x.abs() < ORIGIN {
+            p.x + FLOAT_SCALE * n.x
+        } else {
+            p_i.x
+        },
+        if p.y.abs() < ORIGIN {
+            p.y + FLOAT_SCALE * n.y
+        } else {
+            p_i.y
+        },
+        if p.z.abs() < ORIGIN {
+            p.z + FLOAT_SCALE * n.z
+        } else {
+            p_i.z
+        },
+    )
+}
+
+impl SurfaceInteraction {
+    /// The geometric normal flipped to the side of `w`.
+    #[inline]
+    pub fn n_towards(&self, w: Vec3) -> Vec3 {
+        if self.n.dot(w) < 0.0 {
+            -self.n
+        } else {
+            self.n
+        }
+    }
+
+    /// A ray leaving the surface along `d`, its origin offset to the side `d` points to.
+    #[inline]
+    pub fn spawn_ray(&self, d: Vec3) -> Ray {
+        Ray::new(offset_ray_origin(self.p, self.n_towards(d)), d, self.time)
+    }
+
+    /// A shadow ray towards `target` and the parameter just short of it (for t in (0, tmax)).
+    #[inline]
+    pub fn spawn_ray_to(&self, target: Vec3) -> (Ray, f32) {
+        let o = offset_ray_origin(self.p, self.n_towards(target - self.p));
+        (Ray::new(o, target - o, self.time), 1.0 - SHADOW_EPSILON)
+    }
+}
+
+/// How far short of a light's surface a shadow ray stops (relative to its length).
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// Whether `a` is finite and non-negative in every channel.
+#[inline]
+pub fn is_valid_radiance(a: Spectrum) -> bool {
+    a.is_finite() && a.min_element() >= 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal() {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(0.3, -0.5, 0.8).normalize(),
+            Vec3::X,
+        ] {
+            let f = Frame::from_z(n);
+            assert!((f.s.dot(f.t)).abs() < 1e-6 && (f.s.dot(f.n)).abs() < 1e-6);
+            assert!((f.s.cross(f.t) - f.n).length() < 1e-5);
+            let v = Vec3::new(0.2, 0.4, -0.7);
+            assert!((f.from_local(f.to_local(v)) - v).length() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn offset_moves_off_the_surface_far_from_origin() {
+        for scale in [1e-3f32, 1.0, 1e3, 1e6] {
+            let p = Vec3::new(scale, -scale, 0.5 * scale);
+            let n = Vec3::new(0.0, 0.0, 1.0);
+            let q = offset_ray_origin(p, n);
+            assert!(q.z > p.z, "{scale}: {q} {p}");
+            assert!(q.x == p.x || (q.x - p.x).abs() < 1e-6 * scale.max(1.0));
+        }
+    }
+}

@@ -1,0 +1,129 @@
+//! The per-sample random stream the integrator draws its decisions from (light choice, BSDF
+//! lobes, bounce directions, Russian roulette). It depends only on (pixel, sample index, seed),
+//! so an image does not depend on the thread count or the order samples are traced in.
+//!
+//! Dimensions below [`sobol_burley::NUM_DIMENSIONS`] come from an Owen-scrambled Sobol sequence
+//! indexed by the sample's index within its pixel (as pbrt-v4's padded Sobol sampler), so the
+//! samples of one pixel are stratified in every dimension; later dimensions from a PCG stream.
+
+/// A hash of 64 bits to 64 bits (SplitMix64's finaliser).
+#[inline]
+pub fn mix64(mut x: u64) -> u64 {
+    x ^= x >> 30;
+    x = x.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x ^= x >> 27;
+    x = x.wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// PCG32 (O'Neill): a small, fast generator with 2^64 period per stream.
+#[derive(Clone, Debug)]
+pub struct Pcg32 {
+    state: u64,
+    inc: u64,
+}
+
+impl Pcg32 {
+    /// A generator for `(seed, stream)`.
+    pub fn new(seed: u64, stream: u64) -> Self {
+        let mut r = Self {
+            state: 0,
+            inc: (stream << 1) | 1,
+        };
+        r.next_u32();
+        r.state = r.state.wrapping_add(seed);
+        r.next_u32();
+        r
+    }
+
+    /// The next 32 random bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(self.inc);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+
+    /// A uniform float in [0, 1).
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+}
+
+/// The random numbers of one sample.
+#[derive(Clone, Debug)]
+pub struct SampleStream {
+    index: u32,
+    scramble: u32,
+    dim: u32,
+    rng: Pcg32,
+}
+
+impl SampleStream {
+    /// The stream of sample `index` of pixel `pixel` under `seed`. `first_dim` skips the
+    /// dimensions the sampler already used for the rendering space (film, time, lens).
+    pub fn new(pixel: u64, index: u32, seed: u64, first_dim: u32) -> Self {
+        let key = mix64(pixel ^ mix64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
+        Self {
+            index,
+            scramble: key as u32,
+            dim: first_dim,
+            rng: Pcg32::new(
+                key ^ u64::from(index),
+                mix64(key).wrapping_add(u64::from(index)),
+            ),
+        }
+    }
+
+    /// The next value in [0, 1).
+    #[inline]
+    pub fn next_1d(&mut self) -> f32 {
+        let d = self.dim;
+        self.dim += 1;
+        if d < sobol_burley::NUM_DIMENSIONS {
+            sobol_burley::sample(self.index, d, self.scramble)
+        } else {
+            self.rng.next_f32()
+        }
+    }
+
+    /// The next pair of values in [0, 1)^2.
+    #[inline]
+    pub fn next_2d(&mut self) -> glam::Vec2 {
+        glam::Vec2::new(self.next_1d(), self.next_1d())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn same_inputs_same_stream_and_values_in_range() {
+        let mut a = SampleStream::new(17, 3, 42, 5);
+        let mut b = SampleStream::new(17, 3, 42, 5);
+        for _ in 0..400 {
+            let x = a.next_1d();
+            assert_eq!(x, b.next_1d());
+            assert!((0.0..1.0).contains(&x));
+        }
+        let mut c = SampleStream::new(18, 3, 42, 5);
+        assert_ne!(SampleStream::new(17, 3, 42, 5).next_1d(), c.next_1d());
+    }
+
+    #[test]
+    fn samples_of_one_pixel_are_stratified() {
+        // 16 samples of one pixel in one dimension: one per stratum of width 1/16.
+        let mut strata = [0; 16];
+        for i in 0..16 {
+            let mut s = SampleStream::new(7, i, 1, 9);
+            strata[(s.next_1d() * 16.0) as usize] += 1;
+        }
+        assert_eq!(strata, [1; 16]);
+    }
+}
