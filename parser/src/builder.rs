@@ -555,17 +555,18 @@ impl Builder {
         loc: Loc,
     ) -> Result<()> {
         self.require_world("Texture", &loc)?;
-        let value =
-            match value {
-                "float" => TextureValue::Float,
-                "color" | "spectrum" | "rgb" => TextureValue::Spectrum,
-                other => return Err(Error::at(
+        let value = match value {
+            "float" => TextureValue::Float,
+            "color" | "spectrum" | "rgb" => TextureValue::Spectrum,
+            other => {
+                return Err(Error::at(
                     &loc,
                     format!(
                         "texture type must be \"float\" or \"color\"/\"spectrum\", not \"{other}\""
                     ),
-                )),
-            };
+                ))
+            }
+        };
         self.resolve_textures(&mut params)?;
         let index = self.scene.textures.len();
         let table = match value {

@@ -3,7 +3,7 @@
 use crate::error::{Error, Result};
 use crate::source::{Loc, SourceFile};
 use nom::branch::alt;
-use nom::bytes::complete::{take_till, take_while1};
+use nom::bytes::complete::take_till;
 use nom::character::complete::{char, multispace1, not_line_ending};
 use nom::combinator::value;
 use nom::multi::many0_count;
@@ -50,9 +50,51 @@ fn skip_blank(input: &str) -> IResult<&str, ()> {
     .parse(input)
 }
 
-/// A bare token runs until whitespace, a quote, a bracket or a comment.
+/// The value of a short run of decimal digits with an optional minus sign, exactly.
+#[inline]
+fn small_integer(word: &str) -> Option<f64> {
+    let (neg, digits) = match word.as_bytes() {
+        [b'-', rest @ ..] => (true, rest),
+        rest => (false, rest),
+    };
+    if digits.is_empty() || digits.len() > 15 || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let v = digits
+        .iter()
+        .fold(0u64, |acc, d| acc * 10 + u64::from(d - b'0')) as f64;
+    Some(if neg { -v } else { v })
+}
+
+/// Bytes that end a bare token: ASCII whitespace, quotes, brackets and comments.
+const fn delimiters() -> [bool; 256] {
+    let mut t = [false; 256];
+    let ends = b" \t\n\r\x0b\x0c\"[]#";
+    let mut i = 0;
+    while i < ends.len() {
+        t[ends[i] as usize] = true;
+        i += 1;
+    }
+    t
+}
+
+static DELIMITER: [bool; 256] = delimiters();
+
+/// A bare token runs until whitespace, a quote, a bracket or a comment. A byte table rather
+/// than a per-char predicate: this is the tokenizer's hottest loop. Delimiters are ASCII, so
+/// the split always falls on a character boundary.
 fn bare(input: &str) -> IResult<&str, &str> {
-    take_while1(|c: char| !c.is_whitespace() && !matches!(c, '"' | '[' | ']' | '#')).parse(input)
+    let len = input
+        .bytes()
+        .position(|b| DELIMITER[b as usize])
+        .unwrap_or(input.len());
+    if len == 0 {
+        return Err(nom::Err::Error(nom::error::Error::new(
+            input,
+            nom::error::ErrorKind::TakeWhile1,
+        )));
+    }
+    Ok((&input[len..], &input[..len]))
 }
 
 /// The plain run of a string's characters up to a quote, a backslash or a line break.
@@ -83,13 +125,23 @@ impl Tokenizer {
 
     /// The next token, or `None` at the end of the file.
     pub fn next_token(&mut self) -> Result<Option<Token>> {
-        let text = Arc::clone(&self.file.text);
-        let rest = &text[self.pos..];
-        // skip_blank cannot fail: many0_count accepts zero repetitions.
-        let rest = skip_blank(rest).map_or(rest, |(r, ())| r);
+        let text: &str = &self.file.text;
+        let mut rest = &text[self.pos..];
+        // Most tokens follow a single space: step over it before asking the general parser.
+        if rest.as_bytes().first() == Some(&b' ') {
+            rest = &rest[1..];
+        }
+        if rest
+            .as_bytes()
+            .first()
+            .is_some_and(|b| b.is_ascii_whitespace() || *b == b'#')
+        {
+            // skip_blank cannot fail: many0_count accepts zero repetitions.
+            rest = skip_blank(rest).map_or(rest, |(r, ())| r);
+        }
         let start = text.len() - rest.len();
-        self.pos = start;
         let Some(first) = rest.chars().next() else {
+            self.pos = start;
             return Ok(None);
         };
         let (kind, len) = match first {
@@ -117,6 +169,10 @@ impl Tokenizer {
     }
 
     fn number(&self, word: &str, start: usize) -> Result<f64> {
+        // Integers (mesh indices) are half of a typical scene's numbers: read them directly.
+        if let Some(v) = small_integer(word) {
+            return Ok(v);
+        }
         match word.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
             Ok(_) => Err(Error::at(
@@ -201,6 +257,22 @@ mod tests {
                 Number(2.0),
                 Close
             ]
+        );
+    }
+
+    #[test]
+    fn integers_read_exactly() {
+        for (text, v) in [
+            ("0", 0.0),
+            ("-12", -12.0),
+            ("123456789012345", 123456789012345.0),
+        ] {
+            assert_eq!(tokens(text).unwrap(), vec![TokenKind::Number(v)]);
+        }
+        assert_eq!(tokens("-0").unwrap(), vec![TokenKind::Number(-0.0)]);
+        assert_eq!(
+            tokens("1234567890123456789").unwrap(),
+            vec![TokenKind::Number(1234567890123456789.0)]
         );
     }
 

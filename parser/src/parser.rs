@@ -606,33 +606,34 @@ struct Raw {
 
 impl Raw {
     fn push(&mut self, t: Token, file: &Arc<SourceFile>, name: &str) -> Result<()> {
-        let kind_name =
-            match t.kind {
-                TokenKind::Number(v) => {
-                    self.numbers.push(v);
-                    "number"
-                }
-                TokenKind::Str(s) => {
-                    self.strings.push(s);
-                    "string"
-                }
-                TokenKind::Word(w) if w == "true" || w == "false" => {
-                    self.bools.push(w == "true");
-                    "bool"
-                }
-                TokenKind::Word(w) => return Err(Error::at(
+        let kind_name = match t.kind {
+            TokenKind::Number(v) => {
+                self.numbers.push(v);
+                "number"
+            }
+            TokenKind::Str(s) => {
+                self.strings.push(s);
+                "string"
+            }
+            TokenKind::Word(w) if w == "true" || w == "false" => {
+                self.bools.push(w == "true");
+                "bool"
+            }
+            TokenKind::Word(w) => {
+                return Err(Error::at(
                     &Loc::new(file, t.offset),
                     format!(
                         "parameter \"{name}\": unexpected '{w}' among its values (missing ']'?)"
                     ),
-                )),
-                TokenKind::Open | TokenKind::Close => {
-                    return Err(Error::at(
-                        &Loc::new(file, t.offset),
-                        format!("parameter \"{name}\": unexpected bracket among its values"),
-                    ))
-                }
-            };
+                ))
+            }
+            TokenKind::Open | TokenKind::Close => {
+                return Err(Error::at(
+                    &Loc::new(file, t.offset),
+                    format!("parameter \"{name}\": unexpected bracket among its values"),
+                ))
+            }
+        };
         let kinds = [
             !self.numbers.is_empty(),
             !self.strings.is_empty(),
