@@ -1,0 +1,72 @@
+//! The stats file (`--stats`): one JSON object, as ARCHITECTURE.md specifies.
+
+use serde::Serialize;
+
+/// Seconds spent in each phase.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Seconds {
+    /// Reading and parsing the scene files.
+    pub parse: f64,
+    /// Building the scene (BVH, lights, materials, textures).
+    pub build: f64,
+    /// Tracing samples.
+    pub render: f64,
+    /// Reconstructing the image from the film.
+    pub reconstruct: f64,
+    /// Writing output files.
+    pub write: f64,
+    /// Wall time of the whole command.
+    pub total: f64,
+}
+
+/// Everything the stats file reports.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Stats {
+    /// The scene file.
+    pub scene: String,
+    /// Image width (after crop).
+    pub width: u32,
+    /// Image height (after crop).
+    pub height: u32,
+    /// Samples per pixel asked for.
+    pub spp: u32,
+    /// Samples traced.
+    pub samples: u64,
+    /// Rays traced (camera, continuation and shadow).
+    pub rays: u64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Sampler name.
+    pub sampler: String,
+    /// Reconstruction filter name.
+    pub filter: String,
+    /// Integrator name.
+    pub integrator: String,
+    /// Active dimensions of the rendering space, e.g. ["x","y","t"].
+    pub dims: Vec<String>,
+    /// Clusters of the cluster sampler (null for other samplers).
+    pub clusters: Option<u64>,
+    /// Samples dropped for NaN, infinite or negative radiance.
+    pub dropped_samples: u64,
+    /// Time per phase.
+    pub seconds: Seconds,
+    /// Millions of rays per second of render time.
+    pub mrays_per_s: f64,
+    /// Peak resident memory in MiB.
+    pub peak_rss_mb: f64,
+}
+
+/// Peak resident set size of this process in MiB (Linux: VmHWM), or 0 where unknown.
+pub fn peak_rss_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<f64>().ok())
+        })
+        .map_or(0.0, |kb| kb / 1024.0)
+}
