@@ -1,9 +1,16 @@
 //! The `acr` command line: subcommands and their arguments.
 
+use crate::film::Film;
+use crate::image_io::{write_image, RgbImage};
+use crate::integrator::Integrator;
+use crate::render::{kernel_from_desc, render, spp_from_desc, MAX_SPP};
+use crate::scene::Scene;
+use crate::stats::{peak_rss_mb, Seconds, Stats};
 use clap::{Parser, Subcommand};
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 /// Adaptive cluster rendering for pbrt-v3 scenes.
 #[derive(Parser, Debug)]
@@ -22,12 +29,56 @@ pub enum Command {
         /// The .pbrt scene file.
         scene: PathBuf,
     },
+    /// Render a scene to an image (.exr, .png or .pfm).
+    Render(RenderArgs),
+    /// Compare an image with a reference: MSE, relMSE and PSNR (linear radiance).
+    Diff {
+        /// The image to judge (.exr, .pfm, .hdr or .png).
+        image: PathBuf,
+        /// The reference image, of the same size.
+        reference: PathBuf,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Arguments of `acr render`.
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// The .pbrt scene file.
+    pub scene: PathBuf,
+    /// Output image; the format follows the extension (.exr, .png, .pfm). Default: the Film's
+    /// "filename", else the scene's name with .exr.
+    #[arg(short = 'o', long = "output")]
+    pub output: Option<PathBuf>,
+    /// Samples per pixel (overrides the scene's Sampler).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
+    pub spp: Option<u32>,
+    /// Worker threads (default: every core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Seed of every random decision; the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Write run statistics as JSON to this file.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// No progress bar and no summary line.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
 }
 
 /// Runs the command line; returns the process exit code.
 pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Parse { scene } => parse(&scene),
+        Command::Render(args) => render_command(&args),
+        Command::Diff {
+            image,
+            reference,
+            json,
+        } => diff_command(&image, &reference, json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -40,6 +91,204 @@ fn parse(scene: &Path) -> Result<(), String> {
     let mut out = std::io::stdout().lock();
     // A closed pipe (acr parse x | head) is not an error worth reporting.
     let _ = out.write_all(desc.to_text().as_bytes());
+    Ok(())
+}
+
+/// The output path: the command line's, else the Film's filename (relative to the working
+/// directory, as pbrt-v3 writes it), else the scene's path with `.exr`.
+fn output_path(args: &RenderArgs, film_filename: Option<&str>) -> PathBuf {
+    if let Some(o) = &args.output {
+        return o.clone();
+    }
+    match film_filename {
+        Some(name) if !name.is_empty() => PathBuf::from(name),
+        _ => args.scene.with_extension("exr"),
+    }
+}
+
+fn render_command(args: &RenderArgs) -> Result<(), String> {
+    let t_start = Instant::now();
+    if let Some(n) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build_global()
+            .map_err(|e| format!("cannot start {n} threads: {e}"))?;
+    }
+    let desc = acr_parser::parse_file(&args.scene).map_err(|e| e.to_string())?;
+    let t_parsed = Instant::now();
+
+    let mut warnings = desc.warnings.clone();
+    let scene = Scene::build(&desc, &mut warnings).map_err(|e| e.to_string())?;
+    let integrator =
+        Integrator::new(desc.integrator.as_ref(), &mut warnings).map_err(|e| e.to_string())?;
+    let kernel = kernel_from_desc(desc.filter.as_ref()).map_err(|e| e.to_string())?;
+    let filter_name = desc
+        .filter
+        .as_ref()
+        .map_or("box", |f| f.kind.as_str())
+        .to_owned();
+    let scene_spp = spp_from_desc(desc.sampler.as_ref()).map_err(|e| e.to_string())?;
+    let spp = args.spp.unwrap_or(scene_spp);
+    if let Some(s) = &desc.sampler {
+        if s.kind != "sobol" {
+            // Until the sampler plugins exist (issue 4) every scene gets one sampler.
+            warnings.push(acr_parser::Warning::at(
+                &s.loc,
+                format!(
+                    "sampler \"{}\" is not available yet; using \"sobol\"",
+                    s.kind
+                ),
+            ));
+        }
+        // Sampler parameters acr does not use yet are not worth a warning each.
+        for p in s.params.iter() {
+            p.mark_used();
+        }
+    }
+    if let Some(a) = &desc.accelerator {
+        for p in a.params.iter() {
+            p.mark_used();
+        }
+    }
+    warnings.extend(desc.unused_parameter_warnings());
+    // A file included twice repeats its warnings word for word: print each once.
+    let mut printed = std::collections::HashSet::new();
+    for w in &warnings {
+        let text = w.to_string();
+        if printed.insert(text.clone()) {
+            eprintln!("{text}");
+        }
+    }
+    let output = output_path(args, scene.film.filename.as_deref());
+    check_writable(&output)?;
+    let t_built = Instant::now();
+
+    let mut film = Film::new(scene.film.clone(), kernel);
+    let show_progress = !args.quiet && std::io::stderr().is_terminal();
+    let bar = show_progress.then(|| {
+        let b = indicatif::ProgressBar::new(0);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{wide_bar}] {percent}% samples, eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    });
+    let counts = render(&scene, &integrator, &mut film, spp, args.seed, bar.as_ref());
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let t_rendered = Instant::now();
+
+    let (w, h) = scene.film.size();
+    let image = RgbImage {
+        width: w as usize,
+        height: h as usize,
+        pixels: film.pixels(),
+    };
+    let t_reconstructed = Instant::now();
+    write_image(&output, &image).map_err(|e| format!("{}: {e}", output.display()))?;
+    let t_written = Instant::now();
+
+    let render_s = (t_rendered - t_built).as_secs_f64();
+    let stats = Stats {
+        scene: args.scene.display().to_string(),
+        width: w,
+        height: h,
+        spp,
+        samples: counts.samples,
+        rays: counts.rays,
+        threads: rayon::current_num_threads(),
+        seed: args.seed,
+        sampler: "sobol".into(),
+        filter: filter_name,
+        integrator: integrator.name().into(),
+        dims: scene.dims.names().into_iter().map(str::to_owned).collect(),
+        clusters: None,
+        dropped_samples: counts.dropped,
+        seconds: Seconds {
+            parse: (t_parsed - t_start).as_secs_f64(),
+            build: (t_built - t_parsed).as_secs_f64(),
+            render: render_s,
+            reconstruct: (t_reconstructed - t_rendered).as_secs_f64(),
+            write: (t_written - t_reconstructed).as_secs_f64(),
+            total: t_start.elapsed().as_secs_f64(),
+        },
+        mrays_per_s: if render_s > 0.0 {
+            counts.rays as f64 / render_s / 1e6
+        } else {
+            0.0
+        },
+        peak_rss_mb: peak_rss_mb(),
+    };
+    if let Some(path) = &args.stats {
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+        std::fs::write(path, json + "\n")
+            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    }
+    if counts.dropped > 0 {
+        eprintln!(
+            "warning: {} of {} samples had NaN, infinite or negative radiance and were dropped",
+            counts.dropped, counts.samples
+        );
+    }
+    if !args.quiet {
+        eprintln!(
+            "{}: {w}x{h}, {spp} spp, {:.2} s render, {:.2} Mrays/s, {} threads -> {}",
+            args.scene.display(),
+            render_s,
+            stats.mrays_per_s,
+            stats.threads,
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+fn diff_command(image: &Path, reference: &Path, json: bool) -> Result<(), String> {
+    let read = |p: &Path| {
+        crate::image_io::read_image(p, true).map_err(|e| format!("{}: {e}", p.display()))
+    };
+    let (a, b) = (read(image)?, read(reference)?);
+    let m = crate::metrics::compare(&a, &b)
+        .map_err(|e| format!("{} vs {}: {e}", image.display(), reference.display()))?;
+    if json {
+        let text = serde_json::to_string(&m).map_err(|e| e.to_string())?;
+        println!("{text}");
+    } else {
+        println!(
+            "mse {:.6e}  relmse {:.6e}  psnr {:.3} dB  mean {:.6} (reference {:.6})",
+            m.mse, m.relmse, m.psnr, m.mean, m.reference_mean
+        );
+    }
+    Ok(())
+}
+
+/// Fails early, before the render, when the output cannot be written (unknown format or a
+/// folder that does not exist), so that no render time is lost.
+fn check_writable(output: &Path) -> Result<(), String> {
+    let ext = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if !matches!(ext.as_str(), "exr" | "png" | "pfm") {
+        return Err(format!(
+            "{}: cannot write image format \"{ext}\" (acr writes .exr, .png and .pfm)",
+            output.display()
+        ));
+    }
+    let dir = output.parent().filter(|d| !d.as_os_str().is_empty());
+    if let Some(d) = dir {
+        if !d.is_dir() {
+            return Err(format!(
+                "{}: folder {} does not exist",
+                output.display(),
+                d.display()
+            ));
+        }
+    }
     Ok(())
 }
 

@@ -1,13 +1,27 @@
 //! acr: adaptive cluster rendering of pbrt-v3 scenes. This crate holds the renderer core and the
 //! command line; the parser and the plugins live in their own crates.
 
+pub mod accel;
+pub mod bsdf;
 pub mod camera;
 pub mod cli;
 pub mod film;
 pub mod geometry;
+pub mod image_io;
+pub mod integrator;
+pub mod light;
+pub mod lightdistrib;
+pub mod material;
+pub mod metrics;
+pub mod microfacet;
+pub mod render;
 pub mod sampling;
+pub mod scene;
+pub mod shapes;
+pub mod spectrum;
 pub mod stats;
 pub mod stream;
+pub mod texture;
 pub mod transform;
 
 pub use acr_parser as parser;

@@ -1,0 +1,452 @@
+//! Ray-scene intersection on obvhs's compressed wide BVH (CWBVH, built with PLOC).
+//!
+//! Two levels: every static shape outside an object definition goes, in world space, into one
+//! BVH; object definitions and moving shapes get a BVH each in their own space, placed in the
+//! world by instances, which a top-level BVH (TLAS) holds. An instance's transform may move: the
+//! ray is taken into the instance's space at the ray's time. A static scene with no instances
+//! builds no TLAS and no motion structures. Shadow rays stop at the first hit.
+
+use crate::geometry::{Ray, SurfaceInteraction, Vec3};
+use crate::shapes::triangle::{intersect_triangle, triangle_bounds, triangle_interaction};
+use crate::shapes::{Cylinder, Disk, Sphere, TriangleMesh};
+use crate::transform::MotionTransform;
+use glam::{Mat4, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::BvhBuildParams;
+use std::time::Duration;
+
+/// What a BVH leaf primitive is, and the surface (material, area light) it carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Prim {
+    /// The kind of primitive and its index in its geometry's lists.
+    pub kind: PrimKind,
+    /// Index into the scene's surfaces.
+    pub surface: u32,
+}
+
+/// The kinds of primitive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrimKind {
+    /// Triangle `tri` of mesh `mesh`.
+    Triangle {
+        /// Mesh index.
+        mesh: u32,
+        /// Triangle index within the mesh.
+        tri: u32,
+    },
+    /// A sphere.
+    Sphere(u32),
+    /// A disk.
+    Disk(u32),
+    /// A cylinder.
+    Cylinder(u32),
+}
+
+/// Shapes in one space (the world, or an instance's), with a BVH over them.
+#[derive(Default)]
+pub struct Geometry {
+    /// Triangle meshes.
+    pub meshes: Vec<TriangleMesh>,
+    /// Spheres.
+    pub spheres: Vec<Sphere>,
+    /// Disks.
+    pub disks: Vec<Disk>,
+    /// Cylinders.
+    pub cylinders: Vec<Cylinder>,
+    /// Primitives in BVH leaf order.
+    prims: Vec<Prim>,
+    bvh: Option<CwBvh>,
+}
+
+/// Where along a ray a primitive was hit, with what is needed to finish the interaction.
+#[derive(Clone, Copy, Debug)]
+enum LocalHit {
+    Triangle(crate::shapes::triangle::TriangleHit),
+    Sphere(crate::shapes::sphere::SphereHit),
+    Disk(crate::shapes::disk::DiskHit),
+    Cylinder(crate::shapes::cylinder::CylinderHit),
+}
+
+/// The closest hit of a ray.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// The primitive hit.
+    pub prim: Prim,
+    /// The instance it belongs to, if any.
+    instance: Option<u32>,
+    local: LocalHit,
+}
+
+fn to_obvhs(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(ray.d), 0.0, t_max)
+}
+
+impl Geometry {
+    /// Adds a primitive (call [`Geometry::build`] after the last).
+    pub fn push(&mut self, prim: Prim) {
+        self.prims.push(prim);
+    }
+
+    /// Number of primitives.
+    pub fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// True when there are no primitives.
+    pub fn is_empty(&self) -> bool {
+        self.prims.is_empty()
+    }
+
+    /// Bounds of one primitive.
+    fn prim_bounds(&self, p: &Prim) -> (Vec3, Vec3) {
+        match p.kind {
+            PrimKind::Triangle { mesh, tri } => {
+                triangle_bounds(&self.meshes[mesh as usize], tri as usize)
+            }
+            PrimKind::Sphere(i) => self.spheres[i as usize].world_bound(),
+            PrimKind::Disk(i) => self.disks[i as usize].world_bound(),
+            PrimKind::Cylinder(i) => self.cylinders[i as usize].world_bound(),
+        }
+    }
+
+    /// Bounds of everything.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.prims.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| {
+                let (a, b) = self.prim_bounds(p);
+                (lo.min(a), hi.max(b))
+            },
+        )
+    }
+
+    /// Builds the BVH and reorders primitives into leaf order.
+    pub fn build(&mut self) {
+        if self.prims.is_empty() {
+            self.bvh = None;
+            return;
+        }
+        let aabbs: Vec<Aabb> = self
+            .prims
+            .iter()
+            .map(|p| {
+                let (lo, hi) = self.prim_bounds(p);
+                Aabb::new(Vec3A::from(lo), Vec3A::from(hi))
+            })
+            .collect();
+        let params = if aabbs.len() > 100_000 {
+            BvhBuildParams::fast_build()
+        } else {
+            BvhBuildParams::medium_build()
+        };
+        let bvh = obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut Duration::default());
+        self.prims = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| self.prims[i as usize])
+            .collect();
+        self.bvh = Some(bvh);
+    }
+
+    #[inline]
+    fn intersect_prim(&self, p: &Prim, ray: &Ray, t_max: f32) -> Option<(f32, LocalHit)> {
+        match p.kind {
+            PrimKind::Triangle { mesh, tri } => {
+                intersect_triangle(&self.meshes[mesh as usize], tri as usize, ray, t_max)
+                    .map(|h| (h.t, LocalHit::Triangle(h)))
+            }
+            PrimKind::Sphere(i) => self.spheres[i as usize]
+                .intersect(ray, t_max)
+                .map(|(t, h)| (t, LocalHit::Sphere(h))),
+            PrimKind::Disk(i) => self.disks[i as usize]
+                .intersect(ray, t_max)
+                .map(|(t, h)| (t, LocalHit::Disk(h))),
+            PrimKind::Cylinder(i) => self.cylinders[i as usize]
+                .intersect(ray, t_max)
+                .map(|(t, h)| (t, LocalHit::Cylinder(h))),
+        }
+    }
+
+    /// The closest hit closer than `t_max`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32, instance: Option<u32>) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let mut best: Option<Hit> = None;
+        let mut hit = obvhs::ray::RayHit::none();
+        bvh.ray_traverse(to_obvhs(ray, t_max), &mut hit, |r, id| {
+            let prim = &self.prims[id];
+            match self.intersect_prim(prim, ray, r.tmax) {
+                Some((t, local)) => {
+                    best = Some(Hit {
+                        t,
+                        prim: *prim,
+                        instance,
+                        local,
+                    });
+                    t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        best
+    }
+
+    /// Whether anything lies on the ray closer than `t_max` (stops at the first hit).
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        let Some(bvh) = &self.bvh else {
+            return false;
+        };
+        !bvh.ray_traverse_miss(to_obvhs(ray, t_max), |r, id| {
+            self.intersect_prim(&self.prims[id], ray, r.tmax)
+                .map_or(f32::INFINITY, |(t, _)| t)
+        })
+    }
+
+    /// The full interaction of a hit, in this geometry's space.
+    fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        match (hit.prim.kind, &hit.local) {
+            (PrimKind::Triangle { mesh, tri }, LocalHit::Triangle(h)) => {
+                triangle_interaction(&self.meshes[mesh as usize], tri as usize, ray, h)
+            }
+            (PrimKind::Sphere(i), LocalHit::Sphere(h)) => {
+                self.spheres[i as usize].interaction(ray, hit.t, h)
+            }
+            (PrimKind::Disk(i), LocalHit::Disk(h)) => {
+                self.disks[i as usize].interaction(ray, hit.t, h)
+            }
+            (PrimKind::Cylinder(i), LocalHit::Cylinder(h)) => {
+                self.cylinders[i as usize].interaction(ray, hit.t, h)
+            }
+            // A hit always records the local data of its own primitive kind.
+            _ => unreachable_interaction(ray, hit.t),
+        }
+    }
+}
+
+/// Never reached: `Hit::local` is built together with `Hit::prim`. Returns a harmless point
+/// rather than panicking.
+#[cold]
+fn unreachable_interaction(ray: &Ray, t: f32) -> SurfaceInteraction {
+    let n = -ray.d.normalize_or_zero();
+    SurfaceInteraction {
+        p: ray.at(t),
+        n,
+        uv: glam::Vec2::ZERO,
+        dpdu: Vec3::X,
+        dpdv: Vec3::Y,
+        shading_n: n,
+        shading_dpdu: Vec3::X,
+        wo: n,
+        time: ray.time,
+    }
+}
+
+/// How an instance sits in the world.
+pub enum Placement {
+    /// A fixed world-from-instance matrix and its inverse.
+    Fixed {
+        /// World from instance.
+        to_world: Mat4,
+        /// Instance from world.
+        to_local: Mat4,
+    },
+    /// A moving transform, evaluated at each ray's time.
+    Moving(Box<MotionTransform>),
+}
+
+impl Placement {
+    fn at(&self, time: f32) -> (Mat4, Mat4) {
+        match self {
+            Placement::Fixed { to_world, to_local } => (*to_world, *to_local),
+            Placement::Moving(m) => {
+                let w = m.at(time);
+                (w, w.inverse())
+            }
+        }
+    }
+
+    /// World bounds of instance-space `bounds` over the shutter.
+    fn world_bounds(&self, bounds: (Vec3, Vec3)) -> (Vec3, Vec3) {
+        match self {
+            Placement::Fixed { to_world, .. } => {
+                let c = std::array::from_fn(|i| {
+                    Vec3::new(
+                        if i & 1 == 0 { bounds.0.x } else { bounds.1.x },
+                        if i & 2 == 0 { bounds.0.y } else { bounds.1.y },
+                        if i & 4 == 0 { bounds.0.z } else { bounds.1.z },
+                    )
+                });
+                crate::transform::transform_box(to_world, &c)
+            }
+            Placement::Moving(m) => m.motion_bounds(bounds),
+        }
+    }
+}
+
+/// One placement of a geometry in the world.
+pub struct Instance {
+    /// Index into [`Accel::objects`].
+    pub object: u32,
+    /// Where it is.
+    pub placement: Placement,
+}
+
+/// The scene's acceleration structure.
+#[derive(Default)]
+pub struct Accel {
+    /// Static shapes in world space.
+    pub world: Geometry,
+    /// Geometries placed by instances (object definitions, moving shapes).
+    pub objects: Vec<Geometry>,
+    /// Instances.
+    pub instances: Vec<Instance>,
+    tlas: Option<CwBvh>,
+    tlas_order: Vec<u32>,
+}
+
+impl Accel {
+    /// Builds every BVH. Call once after adding everything.
+    pub fn build(&mut self) {
+        self.world.build();
+        for g in &mut self.objects {
+            g.build();
+        }
+        self.instances
+            .retain(|i| !self.objects[i.object as usize].is_empty());
+        if self.instances.is_empty() {
+            self.tlas = None;
+            return;
+        }
+        let aabbs: Vec<Aabb> = self
+            .instances
+            .iter()
+            .map(|inst| {
+                let b = self.objects[inst.object as usize].bounds();
+                let (lo, hi) = inst.placement.world_bounds(b);
+                Aabb::new(Vec3A::from(lo), Vec3A::from(hi))
+            })
+            .collect();
+        let bvh = obvhs::cwbvh::builder::build_cwbvh(
+            &aabbs,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        self.tlas_order = bvh.primitive_indices.clone();
+        self.tlas = Some(bvh);
+    }
+
+    /// True when anything in the scene moves (there is a moving instance).
+    pub fn has_motion(&self) -> bool {
+        self.instances
+            .iter()
+            .any(|i| matches!(i.placement, Placement::Moving(_)))
+    }
+
+    /// World bounds of all geometry over the shutter.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut b = self.world.bounds();
+        for inst in &self.instances {
+            let (lo, hi) = inst
+                .placement
+                .world_bounds(self.objects[inst.object as usize].bounds());
+            b = (b.0.min(lo), b.1.max(hi));
+        }
+        b
+    }
+
+    /// The closest hit closer than `t_max`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let mut best = self.world.intersect(ray, t_max, None);
+        let Some(tlas) = &self.tlas else {
+            return best;
+        };
+        let t_limit = best.map_or(t_max, |h| h.t);
+        let mut hit = obvhs::ray::RayHit::none();
+        tlas.ray_traverse(to_obvhs(ray, t_limit), &mut hit, |r, id| {
+            let index = self.tlas_order[id];
+            let inst = &self.instances[index as usize];
+            let (_, to_local) = inst.placement.at(ray.time);
+            let local = Ray::new(
+                to_local.transform_point3(ray.o),
+                to_local.transform_vector3(ray.d),
+                ray.time,
+            );
+            match self.objects[inst.object as usize].intersect(&local, r.tmax, Some(index)) {
+                Some(h) => {
+                    best = Some(h);
+                    h.t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        best
+    }
+
+    /// Whether anything lies on the ray closer than `t_max`.
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.world.occluded(ray, t_max) {
+            return true;
+        }
+        let Some(tlas) = &self.tlas else {
+            return false;
+        };
+        !tlas.ray_traverse_miss(to_obvhs(ray, t_max), |_, id| {
+            let inst = &self.instances[self.tlas_order[id] as usize];
+            let (_, to_local) = inst.placement.at(ray.time);
+            let local = Ray::new(
+                to_local.transform_point3(ray.o),
+                to_local.transform_vector3(ray.d),
+                ray.time,
+            );
+            if self.objects[inst.object as usize].occluded(&local, t_max) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+
+    /// The world-space interaction of a hit.
+    pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        let Some(index) = hit.instance else {
+            return self.world.interaction(ray, hit);
+        };
+        let inst = &self.instances[index as usize];
+        let (to_world, to_local) = inst.placement.at(ray.time);
+        let local_ray = Ray::new(
+            to_local.transform_point3(ray.o),
+            to_local.transform_vector3(ray.d),
+            ray.time,
+        );
+        let si = self.objects[inst.object as usize].interaction(&local_ray, hit);
+        transform_interaction(&si, &to_world, &to_local, ray)
+    }
+}
+
+/// Takes an interaction from instance space to the world.
+fn transform_interaction(
+    si: &SurfaceInteraction,
+    to_world: &Mat4,
+    to_local: &Mat4,
+    world_ray: &Ray,
+) -> SurfaceInteraction {
+    let normal = |n: Vec3| {
+        to_local
+            .transpose()
+            .transform_vector3(n)
+            .normalize_or_zero()
+    };
+    SurfaceInteraction {
+        p: to_world.transform_point3(si.p),
+        n: normal(si.n),
+        uv: si.uv,
+        dpdu: to_world.transform_vector3(si.dpdu),
+        dpdv: to_world.transform_vector3(si.dpdv),
+        shading_n: normal(si.shading_n),
+        shading_dpdu: to_world.transform_vector3(si.shading_dpdu),
+        wo: -world_ray.d.normalize(),
+        time: si.time,
+    }
+}

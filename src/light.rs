@@ -1,0 +1,442 @@
+//! Light sources as pbrt-v3 defines them: point, spot, distant, diffuse area and infinite
+//! (constant, or an environment map sampled by importance).
+
+use crate::accel::{Geometry, PrimKind};
+use crate::geometry::{Frame, Spectrum, SurfaceInteraction, Vec2, Vec3};
+use crate::image_io::RgbImage;
+use crate::sampling::Distribution2D;
+use crate::shapes::triangle::{sample_triangle, triangle_area};
+use glam::Mat4;
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+/// A light sample as seen from a point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the point towards the light.
+    pub wi: Vec3,
+    /// Incident radiance (or intensity / distance² for delta lights).
+    pub li: Spectrum,
+    /// Solid-angle density of `wi` (1 for delta lights).
+    pub pdf: f32,
+    /// The point on the light a shadow ray must reach (far away for distant and infinite lights).
+    pub p: Vec3,
+}
+
+/// An environment map with its sampling distribution.
+pub struct EnvMap {
+    image: Arc<RgbImage>,
+    distribution: Distribution2D,
+}
+
+/// Which static world primitive emits.
+#[derive(Clone, Copy, Debug)]
+pub struct AreaShape {
+    /// The primitive in the world geometry.
+    pub kind: PrimKind,
+}
+
+/// A light source.
+pub enum Light {
+    /// `point`: intensity at a position.
+    Point {
+        /// World position.
+        pos: Vec3,
+        /// Intensity.
+        intensity: Spectrum,
+    },
+    /// `spot`: a point light within a cone, with a smooth falloff.
+    Spot {
+        /// World position.
+        pos: Vec3,
+        /// Light-from-world rotation (the cone's axis is local +z).
+        light_from_world: Mat4,
+        /// Intensity.
+        intensity: Spectrum,
+        /// Cosine of the cone's half-angle.
+        cos_total: f32,
+        /// Cosine of where the falloff starts.
+        cos_falloff_start: f32,
+    },
+    /// `distant`: parallel light from one direction.
+    Distant {
+        /// Unit direction towards the light.
+        w: Vec3,
+        /// Radiance.
+        radiance: Spectrum,
+        /// Radius of the scene's bounding sphere.
+        world_radius: f32,
+    },
+    /// `area` / `diffuse`: emission from a shape's surface.
+    Area {
+        /// The emitting primitive.
+        shape: AreaShape,
+        /// Emitted radiance.
+        l_emit: Spectrum,
+        /// Emits on both sides.
+        two_sided: bool,
+        /// Surface area (world space).
+        area: f32,
+    },
+    /// `infinite`: radiance from every direction, constant or from a map.
+    Infinite {
+        /// Radiance scale (times the map when there is one).
+        l: Spectrum,
+        /// The environment map, if any.
+        map: Option<EnvMap>,
+        /// Light-from-world.
+        light_from_world: Mat4,
+        /// World-from-light.
+        world_from_light: Mat4,
+        /// Radius of the scene's bounding sphere.
+        world_radius: f32,
+    },
+}
+
+/// The emitting side rule of area lights.
+#[inline]
+fn area_emission(l_emit: Spectrum, two_sided: bool, n: Vec3, w: Vec3) -> Spectrum {
+    if two_sided || n.dot(w) > 0.0 {
+        l_emit
+    } else {
+        Spectrum::ZERO
+    }
+}
+
+/// (phi, theta) of a unit vector in pbrt's spherical coordinates, as st in [0,1)^2.
+#[inline]
+fn direction_to_st(w: Vec3) -> Vec2 {
+    let theta = w.z.clamp(-1.0, 1.0).acos();
+    let p = w.y.atan2(w.x);
+    let phi = if p < 0.0 { p + 2.0 * PI } else { p };
+    Vec2::new(phi / (2.0 * PI), theta / PI)
+}
+
+impl EnvMap {
+    /// Builds the map's distribution: luminance times sin(theta), as pbrt-v3.
+    pub fn new(image: Arc<RgbImage>) -> Self {
+        let (w, h) = (image.width.max(1), image.height.max(1));
+        let mut values = vec![0.0f32; w * h];
+        for v in 0..h {
+            let sin_theta = (PI * (v as f32 + 0.5) / h as f32).sin();
+            for u in 0..w {
+                values[v * w + u] = crate::spectrum_luminance(image.pixels[v * w + u]) * sin_theta;
+            }
+        }
+        Self {
+            distribution: Distribution2D::new(&values, w, h),
+            image,
+        }
+    }
+
+    /// Bilinear lookup at st (s wraps around, t clamps).
+    pub fn lookup(&self, st: Vec2) -> Spectrum {
+        let (w, h) = (self.image.width, self.image.height);
+        if w == 0 || h == 0 {
+            return Spectrum::ZERO;
+        }
+        let x = st.x * w as f32 - 0.5;
+        let y = st.y * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let px = |i: i64, j: i64| {
+            let i = i.rem_euclid(w as i64) as usize;
+            let j = j.clamp(0, h as i64 - 1) as usize;
+            self.image.pixels[j * w + i]
+        };
+        let (i, j) = (x0 as i64, y0 as i64);
+        (px(i, j) * (1.0 - fx) + px(i + 1, j) * fx) * (1.0 - fy)
+            + (px(i, j + 1) * (1.0 - fx) + px(i + 1, j + 1) * fx) * fy
+    }
+}
+
+impl Light {
+    /// True for lights that a ray can never hit (point, spot, distant).
+    pub fn is_delta(&self) -> bool {
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+        )
+    }
+
+    /// Total emitted power (its luminance drives the power-based light choice).
+    pub fn power(&self) -> Spectrum {
+        match self {
+            Light::Point { intensity, .. } => *intensity * 4.0 * PI,
+            Light::Spot {
+                intensity,
+                cos_total,
+                cos_falloff_start,
+                ..
+            } => *intensity * 2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total)),
+            Light::Distant {
+                radiance,
+                world_radius,
+                ..
+            } => *radiance * PI * world_radius * world_radius,
+            Light::Area {
+                l_emit,
+                two_sided,
+                area,
+                ..
+            } => *l_emit * (if *two_sided { 2.0 } else { 1.0 }) * *area * PI,
+            Light::Infinite {
+                l,
+                map,
+                world_radius,
+                ..
+            } => {
+                let avg = map.as_ref().map_or(Spectrum::ONE, |m| {
+                    let n = m.image.pixels.len().max(1) as f32;
+                    m.image.pixels.iter().copied().sum::<Spectrum>() / n
+                });
+                *l * avg * PI * world_radius * world_radius
+            }
+        }
+    }
+
+    /// Samples incident light at `p`; `None` when there is none to sample.
+    pub fn sample_li(&self, world: &Geometry, p: Vec3, u: Vec2) -> Option<LightSample> {
+        match self {
+            Light::Point { pos, intensity } => {
+                let d2 = pos.distance_squared(p);
+                Some(LightSample {
+                    wi: (*pos - p).normalize(),
+                    li: *intensity / d2,
+                    pdf: 1.0,
+                    p: *pos,
+                })
+            }
+            Light::Spot {
+                pos,
+                light_from_world,
+                intensity,
+                cos_total,
+                cos_falloff_start,
+            } => {
+                let wi = (*pos - p).normalize();
+                let wl = light_from_world.transform_vector3(-wi).normalize();
+                let cos_theta = wl.z;
+                let falloff = if cos_theta < *cos_total {
+                    0.0
+                } else if cos_theta >= *cos_falloff_start {
+                    1.0
+                } else {
+                    let delta = (cos_theta - cos_total) / (cos_falloff_start - cos_total);
+                    (delta * delta) * (delta * delta)
+                };
+                if falloff == 0.0 {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    li: *intensity * falloff / pos.distance_squared(p),
+                    pdf: 1.0,
+                    p: *pos,
+                })
+            }
+            Light::Distant {
+                w,
+                radiance,
+                world_radius,
+            } => Some(LightSample {
+                wi: *w,
+                li: *radiance,
+                pdf: 1.0,
+                p: p + *w * (2.0 * world_radius),
+            }),
+            Light::Area {
+                shape,
+                l_emit,
+                two_sided,
+                area,
+            } => {
+                let (q, n, pdf) = match shape.kind {
+                    PrimKind::Sphere(i) => {
+                        let s = &world.spheres[i as usize];
+                        match s.sample_solid_angle(p, u) {
+                            Some((q, n, pdf)) => (q, n, pdf),
+                            None => {
+                                let (q, n) = s.sample_area(u);
+                                (q, n, area_to_solid_angle(p, q, n, *area)?)
+                            }
+                        }
+                    }
+                    _ => {
+                        let (q, n) = sample_area(world, shape.kind, u);
+                        (q, n, area_to_solid_angle(p, q, n, *area)?)
+                    }
+                };
+                let wi = (q - p).normalize_or_zero();
+                if pdf <= 0.0 || !pdf.is_finite() || wi == Vec3::ZERO {
+                    return None;
+                }
+                let li = area_emission(*l_emit, *two_sided, n, -wi);
+                if li == Spectrum::ZERO {
+                    return None;
+                }
+                Some(LightSample { wi, li, pdf, p: q })
+            }
+            Light::Infinite {
+                l,
+                map,
+                world_from_light,
+                world_radius,
+                ..
+            } => {
+                let (wi, pdf, li) = match map {
+                    Some(m) => {
+                        let (st, map_pdf) = m.distribution.sample(u);
+                        if map_pdf == 0.0 {
+                            return None;
+                        }
+                        let (theta, phi) = (st.y * PI, st.x * 2.0 * PI);
+                        let sin_theta = theta.sin();
+                        if sin_theta == 0.0 {
+                            return None;
+                        }
+                        let wl =
+                            Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), theta.cos());
+                        let wi = world_from_light.transform_vector3(wl).normalize();
+                        (wi, map_pdf / (2.0 * PI * PI * sin_theta), *l * m.lookup(st))
+                    }
+                    None => {
+                        // Uniform over the sphere, as pbrt-v3 does for a constant map.
+                        let wi = crate::sampling::uniform_sample_sphere(u);
+                        (wi, 1.0 / (4.0 * PI), *l)
+                    }
+                };
+                Some(LightSample {
+                    wi,
+                    li,
+                    pdf,
+                    p: p + wi * (2.0 * world_radius),
+                })
+            }
+        }
+    }
+
+    /// Solid-angle density with which [`Light::sample_li`] from `p` would pick the point `q`
+    /// with normal `n` on this area light.
+    pub fn pdf_area_hit(&self, world: &Geometry, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+        match self {
+            Light::Area { shape, area, .. } => {
+                if let PrimKind::Sphere(i) = shape.kind {
+                    let s = &world.spheres[i as usize];
+                    let pdf = s.pdf_solid_angle(p);
+                    if pdf > 0.0 {
+                        return pdf;
+                    }
+                }
+                area_to_solid_angle(p, q, n, *area).unwrap_or(0.0)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Radiance an area light emits from `si` towards `w`.
+    pub fn l(&self, si: &SurfaceInteraction, w: Vec3) -> Spectrum {
+        match self {
+            Light::Area {
+                l_emit, two_sided, ..
+            } => area_emission(*l_emit, *two_sided, si.n, w),
+            _ => Spectrum::ZERO,
+        }
+    }
+
+    /// Radiance of an infinite light along a ray that escapes the scene (direction `d`).
+    pub fn le(&self, d: Vec3) -> Spectrum {
+        match self {
+            Light::Infinite {
+                l,
+                map,
+                light_from_world,
+                ..
+            } => match map {
+                Some(m) => {
+                    let wl = light_from_world.transform_vector3(d).normalize();
+                    *l * m.lookup(direction_to_st(wl))
+                }
+                None => *l,
+            },
+            _ => Spectrum::ZERO,
+        }
+    }
+
+    /// Solid-angle density of sampling direction `d` from an infinite light.
+    pub fn pdf_le(&self, d: Vec3) -> f32 {
+        match self {
+            Light::Infinite {
+                map,
+                light_from_world,
+                ..
+            } => match map {
+                Some(m) => {
+                    let wl = light_from_world.transform_vector3(d).normalize();
+                    let st = direction_to_st(wl);
+                    let sin_theta = (st.y * PI).sin();
+                    if sin_theta == 0.0 {
+                        0.0
+                    } else {
+                        m.distribution.pdf(st) / (2.0 * PI * PI * sin_theta)
+                    }
+                }
+                None => 1.0 / (4.0 * PI),
+            },
+            _ => 0.0,
+        }
+    }
+}
+
+/// A point and normal uniformly distributed by area on a primitive.
+fn sample_area(world: &Geometry, kind: PrimKind, u: Vec2) -> (Vec3, Vec3) {
+    match kind {
+        PrimKind::Triangle { mesh, tri } => {
+            sample_triangle(&world.meshes[mesh as usize], tri as usize, u)
+        }
+        PrimKind::Sphere(i) => world.spheres[i as usize].sample_area(u),
+        PrimKind::Disk(i) => world.disks[i as usize].sample_area(u),
+        PrimKind::Cylinder(i) => world.cylinders[i as usize].sample_area(u),
+    }
+}
+
+/// Area of a primitive (world space).
+pub fn prim_area(world: &Geometry, kind: PrimKind) -> f32 {
+    match kind {
+        PrimKind::Triangle { mesh, tri } => {
+            triangle_area(&world.meshes[mesh as usize], tri as usize)
+        }
+        PrimKind::Sphere(i) => world.spheres[i as usize].area(),
+        PrimKind::Disk(i) => world.disks[i as usize].area(),
+        PrimKind::Cylinder(i) => world.cylinders[i as usize].area(),
+    }
+}
+
+/// Converts the uniform area density 1/area at `q` (normal `n`) to solid angle seen from `p`.
+#[inline]
+fn area_to_solid_angle(p: Vec3, q: Vec3, n: Vec3, area: f32) -> Option<f32> {
+    let d = q - p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    let cos = n.dot(-d / d2.sqrt()).abs();
+    if cos == 0.0 {
+        return None;
+    }
+    let pdf = d2 / (cos * area);
+    pdf.is_finite().then_some(pdf)
+}
+
+/// A frame for a spot light: local +z along `dir`.
+pub fn spot_frame(dir: Vec3) -> Mat4 {
+    let f = Frame::from_z(dir);
+    // Rows are the frame axes: world -> local.
+    Mat4::from_cols(
+        f.s.extend(0.0),
+        f.t.extend(0.0),
+        f.n.extend(0.0),
+        glam::Vec4::W,
+    )
+    .transpose()
+}

@@ -1,0 +1,1003 @@
+//! pbrt-v3's materials (materials/*.cpp): matte, plastic, mirror, glass, metal, uber, substrate
+//! and mix, with textured parameters, each turning a hit into a [`Bsdf`] as pbrt-v3's
+//! `ComputeScatteringFunctions` does (radiance transport, several lobes allowed as the path
+//! integrator asks).
+//!
+//! Not supported: bump mapping (`bumpmap` is ignored with a warning), per-shape overrides of
+//! material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like), and the translucent,
+//! hair, subsurface, kdsubsurface, fourier and disney materials (replaced by a matte with the
+//! material's `Kd`, with a warning).
+
+use crate::bsdf::{Bsdf, Bxdf, Fresnel};
+use crate::geometry::{Spectrum, SurfaceInteraction};
+use crate::microfacet::{roughness_to_alpha, TrowbridgeReitz};
+use crate::texture::{FloatTexture, SpectrumTexture, Texture, TextureBuilder};
+use acr_parser::{Error, MaterialDesc, ParamList, Result, SceneDescription, Warning};
+use std::path::Path;
+use std::sync::Arc;
+
+/// pbrt-v3's copper (metal.cpp's tables through `RGBSpectrum::FromSampled`): the metal
+/// material's default `eta`.
+pub const COPPER_ETA: Spectrum = Spectrum::new(0.200438, 0.924033, 1.10221);
+/// pbrt-v3's copper absorption: the metal material's default `k`.
+pub const COPPER_K: Spectrum = Spectrum::new(3.91295, 2.45285, 2.14219);
+
+/// Material types acr builds.
+const KINDS: [&str; 8] = [
+    "matte",
+    "plastic",
+    "mirror",
+    "glass",
+    "metal",
+    "uber",
+    "substrate",
+    "mix",
+];
+/// pbrt-v3 material types acr replaces by a matte.
+const UNSUPPORTED_KINDS: [&str; 6] = [
+    "translucent",
+    "hair",
+    "subsurface",
+    "kdsubsurface",
+    "fourier",
+    "disney",
+];
+/// Types that make no surface: rays pass through.
+const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
+/// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
+const UNSUPPORTED_PARAMS: [&str; 3] = ["bumpmap", "displacement", "normalmap"];
+
+/// A surface's material, its parameters possibly textured.
+// Materials are built once and kept in one Vec; boxing the large variants would add a pointer
+// chase to every hit for no memory worth saving.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum Material {
+    /// Lambertian, or Oren-Nayar when `sigma` (degrees) is positive.
+    Matte {
+        /// Diffuse reflectance.
+        kd: SpectrumTexture,
+        /// Oren-Nayar roughness in degrees, clamped to [0, 90].
+        sigma: FloatTexture,
+    },
+    /// Diffuse plus a glossy dielectric coat (pbrt-v3's Fresnel 1.5 -> 1 quirk included).
+    Plastic {
+        /// Diffuse reflectance.
+        kd: SpectrumTexture,
+        /// Glossy reflectance.
+        ks: SpectrumTexture,
+        /// Roughness of the coat.
+        roughness: FloatTexture,
+        /// Whether roughness goes through `roughness_to_alpha`.
+        remap_roughness: bool,
+    },
+    /// A perfect mirror.
+    Mirror {
+        /// Reflectance.
+        kr: SpectrumTexture,
+    },
+    /// A dielectric, smooth or rough.
+    Glass {
+        /// Reflectance scale.
+        kr: SpectrumTexture,
+        /// Transmittance scale.
+        kt: SpectrumTexture,
+        /// Index of refraction inside.
+        eta: FloatTexture,
+        /// Roughness along the tangent.
+        u_roughness: FloatTexture,
+        /// Roughness along the bitangent.
+        v_roughness: FloatTexture,
+        /// Whether roughness goes through `roughness_to_alpha`.
+        remap_roughness: bool,
+    },
+    /// A rough conductor.
+    Metal {
+        /// Real part of the index of refraction.
+        eta: SpectrumTexture,
+        /// Absorption coefficient.
+        k: SpectrumTexture,
+        /// Roughness (both directions unless overridden).
+        roughness: FloatTexture,
+        /// Roughness along the tangent, overriding `roughness`.
+        u_roughness: Option<FloatTexture>,
+        /// Roughness along the bitangent, overriding `roughness`.
+        v_roughness: Option<FloatTexture>,
+        /// Whether roughness goes through `roughness_to_alpha`.
+        remap_roughness: bool,
+    },
+    /// pbrt-v3's uber material: diffuse, glossy, specular reflection and transmission, opacity.
+    Uber {
+        /// Diffuse reflectance.
+        kd: SpectrumTexture,
+        /// Glossy reflectance.
+        ks: SpectrumTexture,
+        /// Specular reflectance.
+        kr: SpectrumTexture,
+        /// Specular transmittance.
+        kt: SpectrumTexture,
+        /// Roughness (both directions unless overridden).
+        roughness: FloatTexture,
+        /// Roughness along the tangent, overriding `roughness`.
+        u_roughness: Option<FloatTexture>,
+        /// Roughness along the bitangent (defaults to the tangent's).
+        v_roughness: Option<FloatTexture>,
+        /// Index of refraction.
+        eta: FloatTexture,
+        /// Opacity: below 1, a straight-through transmission lobe of 1 - opacity.
+        opacity: SpectrumTexture,
+        /// Whether roughness goes through `roughness_to_alpha`.
+        remap_roughness: bool,
+    },
+    /// Glossy coat over a diffuse base (pbrt-v3's `FresnelBlend`).
+    Substrate {
+        /// Diffuse reflectance.
+        kd: SpectrumTexture,
+        /// Specular reflectance at normal incidence.
+        ks: SpectrumTexture,
+        /// Roughness along the tangent.
+        u_roughness: FloatTexture,
+        /// Roughness along the bitangent.
+        v_roughness: FloatTexture,
+        /// Whether roughness goes through `roughness_to_alpha`.
+        remap_roughness: bool,
+    },
+    /// pbrt-v3's mix: the lobes of `materials[0]` weighted by `amount`, those of `materials[1]`
+    /// by 1 - amount.
+    Mix {
+        /// Weight of the first material.
+        amount: SpectrumTexture,
+        /// `namedmaterial1` and `namedmaterial2`.
+        materials: [Arc<Material>; 2],
+    },
+    /// No surface (`"none"`, `"interface"`): an empty BSDF. A renderer should let rays pass
+    /// through shapes with this material, as pbrt-v3 does for `Material ""`.
+    Interface,
+}
+
+/// pbrt-v3's `Spectrum::Clamp()`: negative channels to zero.
+#[inline]
+fn clamp0(s: Spectrum) -> Spectrum {
+    s.max(Spectrum::ZERO)
+}
+
+#[inline]
+fn is_black(s: Spectrum) -> bool {
+    s == Spectrum::ZERO
+}
+
+/// A Trowbridge-Reitz distribution from roughnesses, remapped or not.
+#[inline]
+fn distribution(u: f32, v: f32, remap: bool) -> TrowbridgeReitz {
+    if remap {
+        TrowbridgeReitz::new(roughness_to_alpha(u), roughness_to_alpha(v))
+    } else {
+        TrowbridgeReitz::new(u, v)
+    }
+}
+
+impl Material {
+    /// pbrt's default material: matte with Kd 0.5.
+    pub fn default_matte() -> Self {
+        Material::Matte {
+            kd: Texture::Constant(Spectrum::splat(0.5)),
+            sigma: Texture::Constant(0.0),
+        }
+    }
+
+    /// Whether the material makes no surface (rays should pass through).
+    pub fn is_interface(&self) -> bool {
+        matches!(self, Material::Interface)
+    }
+
+    /// The BSDF at a hit (several lobes allowed, as pbrt-v3's path integrators ask: a smooth
+    /// glass is one `FresnelSpecular` lobe).
+    pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
+        self.bsdf_with(si, true)
+    }
+
+    /// The BSDF at a hit. With `allow_multiple_lobes` false (pbrt-v3's direct-lighting and
+    /// Whitted integrators), a smooth glass gets separate specular reflection and transmission
+    /// lobes instead of one `FresnelSpecular`.
+    pub fn bsdf_with(&self, si: &SurfaceInteraction, allow_multiple_lobes: bool) -> Bsdf {
+        match self {
+            Material::Matte { kd, sigma } => {
+                let mut b = Bsdf::new(si, 1.0);
+                let r = clamp0(kd.eval(si));
+                let sig = sigma.eval(si).clamp(0.0, 90.0);
+                if !is_black(r) {
+                    if sig == 0.0 {
+                        b.add(Bxdf::Lambertian { r });
+                    } else {
+                        b.add(Bxdf::oren_nayar(r, sig));
+                    }
+                }
+                b
+            }
+            Material::Plastic {
+                kd,
+                ks,
+                roughness,
+                remap_roughness,
+            } => {
+                let mut b = Bsdf::new(si, 1.0);
+                let kd = clamp0(kd.eval(si));
+                if !is_black(kd) {
+                    b.add(Bxdf::Lambertian { r: kd });
+                }
+                let ks = clamp0(ks.eval(si));
+                if !is_black(ks) {
+                    let rough = roughness.eval(si);
+                    b.add(Bxdf::MicrofacetReflection {
+                        r: ks,
+                        distribution: distribution(rough, rough, *remap_roughness),
+                        // pbrt-v3 builds this Fresnel with the indices swapped.
+                        fresnel: Fresnel::Dielectric {
+                            eta_i: 1.5,
+                            eta_t: 1.0,
+                        },
+                    });
+                }
+                b
+            }
+            Material::Mirror { kr } => {
+                let mut b = Bsdf::new(si, 1.0);
+                let r = clamp0(kr.eval(si));
+                if !is_black(r) {
+                    b.add(Bxdf::SpecularReflection {
+                        r,
+                        fresnel: Fresnel::NoOp,
+                    });
+                }
+                b
+            }
+            Material::Glass {
+                kr,
+                kt,
+                eta,
+                u_roughness,
+                v_roughness,
+                remap_roughness,
+            } => {
+                let eta = eta.eval(si);
+                let (urough, vrough) = (u_roughness.eval(si), v_roughness.eval(si));
+                let r = clamp0(kr.eval(si));
+                let t = clamp0(kt.eval(si));
+                let mut b = Bsdf::new(si, eta);
+                if is_black(r) && is_black(t) {
+                    return b;
+                }
+                let specular = urough == 0.0 && vrough == 0.0;
+                if specular && allow_multiple_lobes {
+                    b.add(Bxdf::FresnelSpecular {
+                        r,
+                        t,
+                        eta_a: 1.0,
+                        eta_b: eta,
+                    });
+                    return b;
+                }
+                let dist = distribution(urough, vrough, *remap_roughness);
+                if !is_black(r) {
+                    let fresnel = Fresnel::Dielectric {
+                        eta_i: 1.0,
+                        eta_t: eta,
+                    };
+                    b.add(if specular {
+                        Bxdf::SpecularReflection { r, fresnel }
+                    } else {
+                        Bxdf::MicrofacetReflection {
+                            r,
+                            distribution: dist,
+                            fresnel,
+                        }
+                    });
+                }
+                if !is_black(t) {
+                    b.add(if specular {
+                        Bxdf::SpecularTransmission {
+                            t,
+                            eta_a: 1.0,
+                            eta_b: eta,
+                        }
+                    } else {
+                        Bxdf::MicrofacetTransmission {
+                            t,
+                            distribution: dist,
+                            eta_a: 1.0,
+                            eta_b: eta,
+                        }
+                    });
+                }
+                b
+            }
+            Material::Metal {
+                eta,
+                k,
+                roughness,
+                u_roughness,
+                v_roughness,
+                remap_roughness,
+            } => {
+                let mut b = Bsdf::new(si, 1.0);
+                let u = u_roughness
+                    .as_ref()
+                    .map_or_else(|| roughness.eval(si), |t| t.eval(si));
+                let v = v_roughness
+                    .as_ref()
+                    .map_or_else(|| roughness.eval(si), |t| t.eval(si));
+                b.add(Bxdf::MicrofacetReflection {
+                    r: Spectrum::ONE,
+                    distribution: distribution(u, v, *remap_roughness),
+                    fresnel: Fresnel::Conductor {
+                        eta_i: Spectrum::ONE,
+                        eta_t: eta.eval(si),
+                        k: k.eval(si),
+                    },
+                });
+                b
+            }
+            Material::Uber {
+                kd,
+                ks,
+                kr,
+                kt,
+                roughness,
+                u_roughness,
+                v_roughness,
+                eta,
+                opacity,
+                remap_roughness,
+            } => {
+                let e = eta.eval(si);
+                let op = clamp0(opacity.eval(si));
+                let t = clamp0(Spectrum::ONE - op);
+                let mut b = if !is_black(t) {
+                    let mut b = Bsdf::new(si, 1.0);
+                    b.add(Bxdf::SpecularTransmission {
+                        t,
+                        eta_a: 1.0,
+                        eta_b: 1.0,
+                    });
+                    b
+                } else {
+                    Bsdf::new(si, e)
+                };
+                let kd = op * clamp0(kd.eval(si));
+                if !is_black(kd) {
+                    b.add(Bxdf::Lambertian { r: kd });
+                }
+                let ks = op * clamp0(ks.eval(si));
+                if !is_black(ks) {
+                    let u = u_roughness
+                        .as_ref()
+                        .map_or_else(|| roughness.eval(si), |t| t.eval(si));
+                    let v = v_roughness.as_ref().map_or(u, |t| t.eval(si));
+                    b.add(Bxdf::MicrofacetReflection {
+                        r: ks,
+                        distribution: distribution(u, v, *remap_roughness),
+                        fresnel: Fresnel::Dielectric {
+                            eta_i: 1.0,
+                            eta_t: e,
+                        },
+                    });
+                }
+                let kr = op * clamp0(kr.eval(si));
+                if !is_black(kr) {
+                    b.add(Bxdf::SpecularReflection {
+                        r: kr,
+                        fresnel: Fresnel::Dielectric {
+                            eta_i: 1.0,
+                            eta_t: e,
+                        },
+                    });
+                }
+                let kt = op * clamp0(kt.eval(si));
+                if !is_black(kt) {
+                    b.add(Bxdf::SpecularTransmission {
+                        t: kt,
+                        eta_a: 1.0,
+                        eta_b: e,
+                    });
+                }
+                b
+            }
+            Material::Substrate {
+                kd,
+                ks,
+                u_roughness,
+                v_roughness,
+                remap_roughness,
+            } => {
+                let mut b = Bsdf::new(si, 1.0);
+                let d = clamp0(kd.eval(si));
+                let s = clamp0(ks.eval(si));
+                if !is_black(d) || !is_black(s) {
+                    let (u, v) = (u_roughness.eval(si), v_roughness.eval(si));
+                    b.add(Bxdf::FresnelBlend {
+                        rd: d,
+                        rs: s,
+                        distribution: distribution(u, v, *remap_roughness),
+                    });
+                }
+                b
+            }
+            Material::Mix { amount, materials } => {
+                let s1 = clamp0(amount.eval(si));
+                let s2 = clamp0(Spectrum::ONE - s1);
+                let mut b = materials[0].bsdf_with(si, allow_multiple_lobes);
+                b.scale_lobes(s1);
+                let b2 = materials[1].bsdf_with(si, allow_multiple_lobes);
+                for l in b2.lobes() {
+                    // pbrt-v3 asserts when more than 8 lobes result; acr drops the extras.
+                    b.add_scaled(l.bxdf, l.scale * s2);
+                }
+                b
+            }
+            Material::Interface => Bsdf::new(si, 1.0),
+        }
+    }
+}
+
+/// Builds materials from their descriptions, textures on demand.
+struct MaterialBuilder<'a> {
+    desc: &'a SceneDescription,
+    textures: TextureBuilder<'a>,
+    built: Vec<Option<Arc<Material>>>,
+    in_progress: Vec<bool>,
+}
+
+impl<'a> MaterialBuilder<'a> {
+    fn build(&mut self, index: usize) -> Result<Arc<Material>> {
+        if let Some(m) = &self.built[index] {
+            return Ok(Arc::clone(m));
+        }
+        let md: &'a MaterialDesc = &self.desc.materials[index];
+        if self.in_progress[index] {
+            return Err(Error::at(
+                &md.plugin.loc,
+                "mix material refers to itself through its named materials",
+            ));
+        }
+        self.in_progress[index] = true;
+        let m = Arc::new(self.make(md)?);
+        self.in_progress[index] = false;
+        self.built[index] = Some(Arc::clone(&m));
+        Ok(m)
+    }
+
+    fn make(&mut self, md: &'a MaterialDesc) -> Result<Material> {
+        let p: &ParamList = &md.plugin.params;
+        let loc = &md.plugin.loc;
+        let kind = md.plugin.kind.as_str();
+        for name in UNSUPPORTED_PARAMS {
+            if let Some(param) = p.get(name) {
+                self.textures.warn_once(
+                    format!("material parameter {name}"),
+                    &param.loc,
+                    format!("material parameter \"{name}\" is not supported; ignored"),
+                );
+            }
+        }
+        let t = &mut self.textures;
+        let remap = |p: &ParamList| p.bool_or("remaproughness", true);
+        Ok(match kind {
+            "matte" => Material::Matte {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
+                sigma: t.float_param(p, "sigma", 0.0)?,
+            },
+            "plastic" => Material::Plastic {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
+                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
+                roughness: t.float_param(p, "roughness", 0.1)?,
+                remap_roughness: remap(p)?,
+            },
+            "mirror" => Material::Mirror {
+                kr: t.spectrum_param(p, "Kr", Spectrum::splat(0.9))?,
+            },
+            "glass" => {
+                let eta = match t.float_param_opt(p, "eta")? {
+                    Some(e) => e,
+                    None => t.float_param(p, "index", 1.5)?,
+                };
+                Material::Glass {
+                    kr: t.spectrum_param(p, "Kr", Spectrum::ONE)?,
+                    kt: t.spectrum_param(p, "Kt", Spectrum::ONE)?,
+                    eta,
+                    u_roughness: t.float_param(p, "uroughness", 0.0)?,
+                    v_roughness: t.float_param(p, "vroughness", 0.0)?,
+                    remap_roughness: remap(p)?,
+                }
+            }
+            "metal" => Material::Metal {
+                eta: t.spectrum_param(p, "eta", COPPER_ETA)?,
+                k: t.spectrum_param(p, "k", COPPER_K)?,
+                roughness: t.float_param(p, "roughness", 0.01)?,
+                u_roughness: t.float_param_opt(p, "uroughness")?,
+                v_roughness: t.float_param_opt(p, "vroughness")?,
+                remap_roughness: remap(p)?,
+            },
+            "uber" => {
+                let eta = match t.float_param_opt(p, "eta")? {
+                    Some(e) => e,
+                    None => t.float_param(p, "index", 1.5)?,
+                };
+                Material::Uber {
+                    kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
+                    ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
+                    kr: t.spectrum_param(p, "Kr", Spectrum::ZERO)?,
+                    kt: t.spectrum_param(p, "Kt", Spectrum::ZERO)?,
+                    roughness: t.float_param(p, "roughness", 0.1)?,
+                    u_roughness: t.float_param_opt(p, "uroughness")?,
+                    v_roughness: t.float_param_opt(p, "vroughness")?,
+                    eta,
+                    opacity: t.spectrum_param(p, "opacity", Spectrum::ONE)?,
+                    remap_roughness: remap(p)?,
+                }
+            }
+            "substrate" => Material::Substrate {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
+                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.5))?,
+                u_roughness: t.float_param(p, "uroughness", 0.1)?,
+                v_roughness: t.float_param(p, "vroughness", 0.1)?,
+                remap_roughness: remap(p)?,
+            },
+            "mix" => {
+                let amount = t.spectrum_param(p, "amount", Spectrum::splat(0.5))?;
+                let Some([a, b]) = md.mix else {
+                    return Err(Error::at(
+                        loc,
+                        "mix material needs \"string namedmaterial1\" and \"namedmaterial2\"",
+                    ));
+                };
+                Material::Mix {
+                    amount,
+                    materials: [self.build(a)?, self.build(b)?],
+                }
+            }
+            k if INTERFACE_KINDS.contains(&k) => Material::Interface,
+            k if UNSUPPORTED_KINDS.contains(&k) => {
+                t.warn_once(
+                    format!("material {k}"),
+                    loc,
+                    format!("material \"{k}\" is not supported; a matte with its Kd is used"),
+                );
+                Material::Matte {
+                    kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
+                    sigma: Texture::Constant(0.0),
+                }
+            }
+            other => return Err(unknown_kind(other, loc)),
+        })
+    }
+}
+
+fn unknown_kind(kind: &str, loc: &acr_parser::Loc) -> Error {
+    let hint = acr_parser::closest(kind, KINDS.iter().chain(&UNSUPPORTED_KINDS).copied())
+        .map_or(String::new(), |k| format!(" (did you mean \"{k}\"?)"));
+    Error::at(loc, format!("unknown material \"{kind}\"{hint}"))
+}
+
+/// Which materials shapes use, directly or through mix materials.
+fn used_materials(desc: &SceneDescription) -> Vec<bool> {
+    let n = desc.materials.len();
+    let mut used = vec![false; n];
+    let mut stack: Vec<usize> = desc
+        .shapes
+        .iter()
+        .chain(desc.objects.values().flat_map(|o| o.shapes.iter()))
+        .filter_map(|s| s.material)
+        .collect();
+    while let Some(i) = stack.pop() {
+        if i >= n || used[i] {
+            continue;
+        }
+        used[i] = true;
+        if let Some(pair) = desc.materials[i].mix {
+            stack.extend(pair);
+        }
+    }
+    used
+}
+
+/// Builds `desc.materials` (index i is `desc.materials[i]`). Materials no shape uses (directly
+/// or through a mix) are not built: they get pbrt's default matte, their parameters are marked
+/// used, and their textures are never read. Every material's type is checked: an unknown type
+/// is an error at its location. Warnings (unsupported parameters or types, each once) are
+/// appended to `warnings`. `main_dir` is the main scene file's directory, where file names
+/// that are not next to the file naming them are looked for.
+pub fn build_materials(
+    desc: &SceneDescription,
+    main_dir: &Path,
+    warnings: &mut Vec<Warning>,
+) -> Result<Vec<Material>> {
+    for md in &desc.materials {
+        let k = md.plugin.kind.as_str();
+        if !(KINDS.contains(&k) || UNSUPPORTED_KINDS.contains(&k) || INTERFACE_KINDS.contains(&k)) {
+            return Err(unknown_kind(k, &md.plugin.loc));
+        }
+    }
+    let used = used_materials(desc);
+    let n = desc.materials.len();
+    let mut b = MaterialBuilder {
+        desc,
+        textures: TextureBuilder::new(desc, main_dir),
+        built: vec![None; n],
+        in_progress: vec![false; n],
+    };
+    let mut out = Vec::with_capacity(n);
+    for (i, md) in desc.materials.iter().enumerate() {
+        if used[i] {
+            out.push((*b.build(i)?).clone());
+        } else {
+            for p in md.plugin.params.iter() {
+                p.mark_used();
+            }
+            out.push(Material::default_matte());
+        }
+    }
+    warnings.extend(b.textures.finish());
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::check::*;
+    use crate::geometry::{Vec2, Vec3};
+    use acr_parser::parse_str;
+
+    fn si() -> SurfaceInteraction {
+        SurfaceInteraction {
+            p: Vec3::new(0.1, 0.2, 0.0),
+            n: Vec3::Z,
+            uv: Vec2::new(0.3, 0.6),
+            dpdu: Vec3::X,
+            dpdv: Vec3::Y,
+            shading_n: Vec3::Z,
+            shading_dpdu: Vec3::X,
+            wo: Vec3::Z,
+            time: 0.0,
+        }
+    }
+
+    /// Parses world-block text and builds its materials, every one used by a shape.
+    fn build(text: &str) -> (Vec<Material>, Vec<Warning>) {
+        build_in(text, Path::new("/tmp"))
+    }
+
+    fn build_in(text: &str, dir: &Path) -> (Vec<Material>, Vec<Warning>) {
+        let full = format!("WorldBegin\n{text}\nWorldEnd\n");
+        let desc = parse_str(&full, &dir.join("scene.pbrt")).unwrap();
+        let mut w = Vec::new();
+        let m = build_materials(&desc, dir, &mut w).unwrap();
+        (m, w)
+    }
+
+    fn build_err(text: &str) -> Error {
+        let full = format!("WorldBegin\n{text}\nWorldEnd\n");
+        let desc = parse_str(&full, Path::new("/tmp/scene.pbrt")).unwrap();
+        build_materials(&desc, Path::new("/tmp"), &mut Vec::new()).unwrap_err()
+    }
+
+    const SHAPE: &str = r#"Shape "sphere""#;
+
+    /// Every material with typical (white where it matters) parameters.
+    fn typical() -> Vec<(&'static str, String)> {
+        [
+            ("matte", r#"Material "matte" "rgb Kd" [1 1 1]"#),
+            ("matte-oren-nayar", r#"Material "matte" "rgb Kd" [1 1 1] "float sigma" 30"#),
+            ("plastic", r#"Material "plastic" "rgb Kd" [0.5 0.5 0.5] "rgb Ks" [0.5 0.5 0.5]"#),
+            ("plastic-smooth", r#"Material "plastic" "float roughness" 0.01"#),
+            ("metal", r#"Material "metal""#),
+            ("metal-aniso", r#"Material "metal" "float uroughness" 0.05 "float vroughness" 0.3"#),
+            ("metal-raw", r#"Material "metal" "float roughness" 0.3 "bool remaproughness" false"#),
+            ("glass-rough", r#"Material "glass" "float uroughness" 0.2 "float vroughness" 0.2"#),
+            ("uber", r#"Material "uber" "rgb Kd" [0.5 0.5 0.5] "rgb Ks" [0.5 0.5 0.5]"#),
+            (
+                "uber-translucent",
+                r#"Material "uber" "rgb Kd" [0.5 0.5 0.5] "rgb opacity" [0.5 0.5 0.5]"#,
+            ),
+            ("substrate", r#"Material "substrate" "rgb Kd" [1 1 1] "rgb Ks" [0.04 0.04 0.04]"#),
+            (
+                "mix",
+                r#"MakeNamedMaterial "a" "string type" "matte" "rgb Kd" [1 1 1]
+                   MakeNamedMaterial "b" "string type" "plastic" "rgb Kd" [0.5 0.5 0.5] "rgb Ks" [0.5 0.5 0.5]
+                   MakeNamedMaterial "m" "string type" "mix" "string namedmaterial1" "a"
+                     "string namedmaterial2" "b" "rgb amount" [0.3 0.5 0.7]
+                   NamedMaterial "m""#,
+            ),
+        ]
+        .into_iter()
+        .map(|(n, t)| (n, format!("{t}\n{SHAPE}")))
+        .collect()
+    }
+
+    #[test]
+    fn typical_materials_sample_consistently_and_conserve_energy() {
+        for (name, text) in typical() {
+            let (mats, warnings) = build(&text);
+            assert!(warnings.is_empty(), "{name}: {warnings:?}");
+            let m = mats.last().unwrap();
+            let bsdf = m.bsdf(&si());
+            assert!(bsdf.num_lobes() > 0, "{name}");
+            assert!(bsdf.has_non_specular(), "{name}");
+            for (k, wo) in test_directions().into_iter().enumerate() {
+                sample_matches_eval(&bsdf, wo, 1000, 17 + k as u64);
+                let (integral, se, success) = pdf_integral(&bsdf, wo, 120, 3 + k as u64);
+                let tol = 4.0 * se + 0.01;
+                let transmits = bsdf
+                    .lobes()
+                    .iter()
+                    .any(|l| matches!(l.bxdf, Bxdf::MicrofacetTransmission { .. }));
+                if transmits && wo.z.abs() < 0.2 {
+                    // pbrt-v3's rough transmission pdf counts back-facing microfacets at grazing
+                    // angles, which its sampler never picks (see the bsdf tests).
+                    assert!(integral < 1.1, "{name} {wo}: ∫pdf = {integral}");
+                } else {
+                    assert!(
+                        integral <= 1.0 + tol && (integral - success).abs() < tol,
+                        "{name} {wo}: ∫pdf = {integral} ± {se}, success rate {success}"
+                    );
+                }
+                if wo.z > 0.0 {
+                    let (a, se) = albedo(&bsdf, wo, 10_000, 5 + k as u64);
+                    assert!(
+                        a.max_element() <= 1.0 + 3.0 * se + 1e-3,
+                        "{name} {wo}: albedo {a} ± {se}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn defaults_follow_pbrt_v3() {
+        let (m, _) = build(&format!("Material \"plastic\"\n{SHAPE}"));
+        let Material::Plastic {
+            kd,
+            ks,
+            roughness,
+            remap_roughness,
+        } = m.last().unwrap()
+        else {
+            panic!()
+        };
+        assert_eq!(kd.as_constant(), Some(Spectrum::splat(0.25)));
+        assert_eq!(ks.as_constant(), Some(Spectrum::splat(0.25)));
+        assert_eq!(roughness.as_constant(), Some(0.1));
+        assert!(remap_roughness);
+
+        let (m, _) = build(&format!("Material \"metal\"\n{SHAPE}"));
+        let Material::Metal {
+            eta,
+            k,
+            roughness,
+            u_roughness,
+            ..
+        } = m.last().unwrap()
+        else {
+            panic!()
+        };
+        assert_eq!(eta.as_constant(), Some(COPPER_ETA));
+        assert_eq!(k.as_constant(), Some(COPPER_K));
+        assert_eq!(roughness.as_constant(), Some(0.01));
+        assert!(u_roughness.is_none());
+
+        // The default material (index 0) is matte 0.5.
+        let Material::Matte { kd, sigma } = &m[0] else {
+            panic!()
+        };
+        assert_eq!(kd.as_constant(), Some(Spectrum::splat(0.5)));
+        assert_eq!(sigma.as_constant(), Some(0.0));
+
+        // Glass takes "eta", or else "index".
+        let (m, _) = build(&format!("Material \"glass\" \"float index\" 1.33\n{SHAPE}"));
+        let Material::Glass { eta, .. } = m.last().unwrap() else {
+            panic!()
+        };
+        assert_eq!(eta.as_constant(), Some(1.33));
+        let (m, _) = build(&format!("Material \"glass\" \"float eta\" 2.4\n{SHAPE}"));
+        let Material::Glass { eta, .. } = m.last().unwrap() else {
+            panic!()
+        };
+        assert_eq!(eta.as_constant(), Some(2.4));
+    }
+
+    #[test]
+    fn smooth_glass_is_one_fresnel_specular_lobe() {
+        let (m, _) = build(&format!("Material \"glass\"\n{SHAPE}"));
+        let b = m.last().unwrap().bsdf(&si());
+        assert_eq!(b.num_lobes(), 1);
+        assert!(!b.has_non_specular());
+        assert!((b.eta() - 1.5).abs() < 1e-6);
+        assert!(matches!(b.lobes()[0].bxdf, Bxdf::FresnelSpecular { .. }));
+        // Reflection and transmission probabilities sum to one over many samples.
+        let wo = Vec3::new(0.3, 0.0, 0.954).normalize();
+        let mut rng = Rng::new(4);
+        let n = 20_000;
+        let mut reflected = 0;
+        for _ in 0..n {
+            let s = b.sample_f(wo, rng.next_2d(), rng.next_f32()).unwrap();
+            assert!(s.specular);
+            if s.wi.z > 0.0 {
+                reflected += 1;
+                assert!((s.f * s.wi.z / s.pdf - Spectrum::ONE).abs().max_element() < 1e-4);
+            } else {
+                let w = s.f * s.wi.z.abs() / s.pdf;
+                assert!(
+                    (w - Spectrum::splat(1.0 / 2.25)).abs().max_element() < 1e-4,
+                    "{w}"
+                );
+            }
+        }
+        let fr = crate::bsdf::fr_dielectric(wo.z, 1.0, 1.5);
+        assert!((reflected as f32 / n as f32 - fr).abs() < 0.005);
+        // Without multiple lobes: separate specular reflection and transmission.
+        let b = m.last().unwrap().bsdf_with(&si(), false);
+        assert_eq!(b.num_lobes(), 2);
+    }
+
+    #[test]
+    fn mirror_and_uber_specular_lobes() {
+        let (m, _) = build(&format!("Material \"mirror\"\n{SHAPE}"));
+        let b = m.last().unwrap().bsdf(&si());
+        let s = b.sample_f(Vec3::Z, Vec2::splat(0.5), 0.5).unwrap();
+        assert!(s.specular);
+        assert!(
+            (s.f * s.wi.z / s.pdf - Spectrum::splat(0.9))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
+
+        let (m, _) = build(&format!(
+            "Material \"uber\" \"rgb Kr\" [1 1 1] \"rgb Kt\" [1 1 1] \"rgb opacity\" [0.25 0.25 0.25]\n{SHAPE}"
+        ));
+        let b = m.last().unwrap().bsdf(&si());
+        // Straight-through transmission, diffuse, glossy, specular reflection and transmission.
+        assert_eq!(b.num_lobes(), 5);
+        assert_eq!(b.eta(), 1.0);
+        let Bxdf::SpecularTransmission { t, eta_a, eta_b } = b.lobes()[0].bxdf else {
+            panic!()
+        };
+        assert_eq!((t, eta_a, eta_b), (Spectrum::splat(0.75), 1.0, 1.0));
+    }
+
+    #[test]
+    fn mix_scales_first_by_amount() {
+        let text = format!(
+            r#"MakeNamedMaterial "a" "string type" "matte" "rgb Kd" [1 1 1]
+               MakeNamedMaterial "b" "string type" "matte" "rgb Kd" [0 1 0]
+               MakeNamedMaterial "m" "string type" "mix" "string namedmaterial1" "a"
+                 "string namedmaterial2" "b" "float amount" 0.25
+               NamedMaterial "m"
+               {SHAPE}"#
+        );
+        // A float amount is not a spectrum: pbrt-v3 ignores it (default 0.5) and so does acr.
+        let (m, _) = build(&text);
+        let b = m.last().unwrap().bsdf(&si());
+        assert_eq!(b.num_lobes(), 2);
+        let f = b.f(Vec3::Z, Vec3::Z);
+        assert!(
+            (f - Spectrum::new(0.5, 1.0, 0.5) / std::f32::consts::PI)
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+
+        let text = text.replace("\"float amount\" 0.25", "\"rgb amount\" [0.25 0.25 0.25]");
+        let (m, _) = build(&text);
+        let b = m.last().unwrap().bsdf(&si());
+        assert_eq!(b.lobes()[0].scale, Spectrum::splat(0.25));
+        assert_eq!(b.lobes()[1].scale, Spectrum::splat(0.75));
+        let f = b.f(Vec3::Z, Vec3::Z) * std::f32::consts::PI;
+        assert!(
+            (f - Spectrum::new(0.25, 1.0, 0.25)).abs().max_element() < 1e-6,
+            "{f}"
+        );
+    }
+
+    #[test]
+    fn textured_parameters_vary_over_the_surface() {
+        let text = format!(
+            r#"Texture "c" "spectrum" "checkerboard" "float uscale" 2 "float vscale" 2
+                 "rgb tex1" [1 0 0] "rgb tex2" [0 0 1]
+               Material "matte" "texture Kd" "c"
+               {SHAPE}"#
+        );
+        let (m, _) = build(&text);
+        let mut s = si();
+        s.uv = Vec2::new(0.1, 0.1);
+        let a = m.last().unwrap().bsdf(&s).f(Vec3::Z, Vec3::Z);
+        s.uv = Vec2::new(0.6, 0.1);
+        let b = m.last().unwrap().bsdf(&s).f(Vec3::Z, Vec3::Z);
+        assert!(
+            a.x > 0.0 && a.z == 0.0 && b.x == 0.0 && b.z > 0.0,
+            "{a} {b}"
+        );
+    }
+
+    #[test]
+    fn unsupported_parameters_warn_once_and_unknown_types_fail() {
+        let (_, w) = build(&format!(
+            r#"Texture "bump" "float" "constant"
+               Material "matte" "texture bumpmap" "bump"
+               {SHAPE}
+               Material "plastic" "texture bumpmap" "bump"
+               {SHAPE}"#
+        ));
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].message.contains("bumpmap") && w[0].loc.is_some());
+
+        let e = build_err(&format!("Material \"platic\"\n{SHAPE}"));
+        assert!(e.message().contains("unknown material \"platic\""), "{e}");
+        assert!(e.message().contains("plastic"), "{e}");
+        assert!(matches!(e, Error::At { .. }));
+
+        let (m, w) = build(&format!(
+            "Material \"translucent\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
+        ));
+        assert_eq!(w.len(), 1);
+        assert!(matches!(m.last().unwrap(), Material::Matte { .. }));
+
+        let (m, _) = build(&format!(
+            "MakeNamedMaterial \"air\" \"string type\" \"none\"\nNamedMaterial \"air\"\n{SHAPE}"
+        ));
+        assert!(m.last().unwrap().is_interface());
+        assert_eq!(m.last().unwrap().bsdf(&si()).num_lobes(), 0);
+    }
+
+    #[test]
+    fn unused_materials_load_no_images() {
+        let dir = std::env::temp_dir().join(format!("acr-material-lazy-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // The image does not exist: reading it would fail.
+        let text = r#"Texture "img" "spectrum" "imagemap" "string filename" "missing.png"
+            Material "matte" "texture Kd" "img"
+            Material "plastic"
+            Shape "sphere""#;
+        let (m, w) = build_in(text, &dir);
+        assert!(w.is_empty(), "{w:?}");
+        assert!(matches!(m.last().unwrap(), Material::Plastic { .. }));
+        // Used, it is an error.
+        let text = text.replace("Material \"plastic\"\n", "");
+        let full = format!("WorldBegin\n{text}\nWorldEnd\n");
+        let desc = parse_str(&full, &dir.join("scene.pbrt")).unwrap();
+        let e = build_materials(&desc, &dir, &mut Vec::new()).unwrap_err();
+        assert!(e.message().contains("missing.png"), "{e}");
+        assert!(desc.unused_parameter_warnings().is_empty());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn images_shared_by_materials_are_read_once() {
+        let dir = std::env::temp_dir().join(format!("acr-material-once-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut img = crate::image_io::RgbImage::new(2, 2);
+        img.pixels.fill(Spectrum::splat(0.5));
+        crate::image_io::write_image(&dir.join("t.pfm"), &img).unwrap();
+        let text = r#"Texture "a" "spectrum" "imagemap" "string filename" "t.pfm"
+            Texture "b" "spectrum" "imagemap" "string filename" "t.pfm" "float uscale" 4
+            Material "matte" "texture Kd" "a"
+            Shape "sphere"
+            Material "plastic" "texture Kd" "b" "texture Ks" "a"
+            Shape "sphere""#;
+        let full = format!("WorldBegin\n{text}\nWorldEnd\n");
+        let desc = parse_str(&full, &dir.join("scene.pbrt")).unwrap();
+        let used = used_materials(&desc);
+        let mut b = MaterialBuilder {
+            desc: &desc,
+            textures: TextureBuilder::new(&desc, &dir),
+            built: vec![None; desc.materials.len()],
+            in_progress: vec![false; desc.materials.len()],
+        };
+        for (i, u) in used.iter().enumerate() {
+            if *u {
+                b.build(i).unwrap();
+            }
+        }
+        assert_eq!(b.textures.files_read(), 1);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

@@ -1,0 +1,595 @@
+//! The renderable scene, built once from a [`SceneDescription`]: camera, film settings,
+//! acceleration structure, lights, materials, and which dimensions the rendering space needs.
+
+use crate::accel::{Accel, Geometry, Instance, Placement, Prim, PrimKind};
+use crate::camera::Camera;
+use crate::film::FilmSettings;
+use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3};
+use crate::light::{prim_area, spot_frame, AreaShape, EnvMap, Light};
+use crate::lightdistrib::{LightDistribution, LightStrategy};
+use crate::material::Material;
+use crate::sampling::Distribution1D;
+use crate::shapes::{Cylinder, Disk, Sphere, Transform, TriangleMesh};
+use crate::transform::MotionTransform;
+use acr_parser::{
+    Error, ParamList, ParamType, PluginDesc, Result, SceneDescription, ShapeDesc, Warning,
+};
+use glam::DMat4;
+use std::collections::HashSet;
+use std::path::Path;
+use std::sync::{Arc, OnceLock};
+
+/// What a primitive's surface is: its material and the area light it carries.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Surface {
+    /// Index into [`Scene::materials`]; `None` for an interface (`Material ""`).
+    pub material: Option<u32>,
+    /// Index into [`Scene::lights`] when the primitive emits.
+    pub area_light: Option<u32>,
+}
+
+/// The dimensions of the rendering space beyond the image plane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Dims {
+    /// Something moves while the shutter is open: sample time.
+    pub time: bool,
+    /// The camera has a lens: sample the lens.
+    pub lens: bool,
+}
+
+impl Dims {
+    /// The names of the active dimensions, as the stats file reports them.
+    pub fn names(&self) -> Vec<&'static str> {
+        let mut v = vec!["x", "y"];
+        if self.time {
+            v.push("t");
+        }
+        if self.lens {
+            v.extend(["u", "v"]);
+        }
+        v
+    }
+
+    /// How many dimensions.
+    pub fn count(&self) -> usize {
+        2 + usize::from(self.time) + 2 * usize::from(self.lens)
+    }
+}
+
+/// A scene ready to render.
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Film settings.
+    pub film: FilmSettings,
+    /// The acceleration structure.
+    pub accel: Accel,
+    /// Every light.
+    pub lights: Vec<Light>,
+    /// Light choice for next-event estimation, one per strategy (spatial built on first use).
+    light_choice: LightChoices,
+    /// Indices of infinite lights (seen by rays that escape).
+    pub infinite_lights: Vec<u32>,
+    /// Materials by index.
+    pub materials: Vec<Material>,
+    /// Surfaces by index.
+    pub surfaces: Vec<Surface>,
+    /// Active dimensions of the rendering space.
+    pub dims: Dims,
+    /// Centre of the scene's bounding sphere.
+    pub world_center: Vec3,
+    /// Radius of the scene's bounding sphere.
+    pub world_radius: f32,
+}
+
+/// A ray's closest hit, resolved.
+pub struct SceneHit {
+    /// Where it hit.
+    pub si: SurfaceInteraction,
+    /// What it hit.
+    pub surface: Surface,
+}
+
+impl Scene {
+    /// The closest hit along the ray, if any.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<SceneHit> {
+        let hit = self.accel.intersect(ray, f32::INFINITY)?;
+        let si = self.accel.interaction(ray, &hit);
+        Some(SceneHit {
+            si,
+            surface: self.surfaces[hit.prim.surface as usize],
+        })
+    }
+
+    /// Whether the segment from `si` to `target` is blocked.
+    #[inline]
+    pub fn occluded(&self, si: &SurfaceInteraction, target: Vec3) -> bool {
+        let (ray, t_max) = si.spawn_ray_to(target);
+        self.accel.occluded(&ray, t_max)
+    }
+
+    /// The distribution to choose a light from at `p` under `strategy`.
+    #[inline]
+    pub fn light_choice(&self, strategy: LightStrategy, p: Vec3) -> &Distribution1D {
+        let c = &self.light_choice;
+        match strategy {
+            LightStrategy::Uniform => &c.uniform,
+            LightStrategy::Power => &c.power,
+            LightStrategy::Spatial => c
+                .spatial
+                .get_or_init(|| LightDistribution::new(strategy, &self.lights, c.bounds))
+                .lookup(p, &self.lights, &self.accel.world),
+        }
+    }
+}
+
+/// The light distributions of a scene.
+struct LightChoices {
+    uniform: Distribution1D,
+    power: Distribution1D,
+    spatial: OnceLock<LightDistribution>,
+    bounds: (Vec3, Vec3),
+}
+
+/// Shape types pbrt-v3 has and acr does not: warned about once and skipped.
+const UNSUPPORTED_SHAPES: &[&str] = &[
+    "curve",
+    "nurbs",
+    "heightfield",
+    "cone",
+    "paraboloid",
+    "hyperboloid",
+];
+
+/// Builds scenes, collecting warnings.
+struct Builder<'a> {
+    desc: &'a SceneDescription,
+    warnings: &'a mut Vec<Warning>,
+    warned: HashSet<String>,
+    surfaces: Vec<Surface>,
+    lights: Vec<Light>,
+    /// Area lights waiting for the world's bounds: (light description, surface index).
+    area_lights: Vec<(Arc<PluginDesc>, PrimKind, u32)>,
+}
+
+fn transform_of(m: &DMat4) -> Transform {
+    let m32 = m.as_mat4();
+    Transform {
+        m: m32,
+        inv: m.inverse().as_mat4(),
+    }
+}
+
+impl Builder<'_> {
+    fn warn_once(&mut self, key: String, loc: &acr_parser::Loc, msg: String) {
+        if self.warned.insert(key) {
+            self.warnings.push(Warning::at(loc, msg));
+        }
+    }
+
+    fn surface(&mut self, s: Surface) -> u32 {
+        self.surfaces.push(s);
+        (self.surfaces.len() - 1) as u32
+    }
+
+    /// Adds one shape's primitives to `geom`, placed by `m` (world- or instance-from-object).
+    /// Area lights are only allowed for static world shapes (`emit`).
+    fn add_shape(
+        &mut self,
+        geom: &mut Geometry,
+        shape: &ShapeDesc,
+        m: &DMat4,
+        emit: bool,
+    ) -> Result<()> {
+        let p = &shape.plugin;
+        let kind = p.kind.as_str();
+        if UNSUPPORTED_SHAPES.contains(&kind) {
+            self.warn_once(
+                format!("shape {kind}"),
+                &p.loc,
+                format!("shape \"{kind}\" is not supported; shapes of this type are skipped"),
+            );
+            return Ok(());
+        }
+        let area_light = shape.area_light.as_ref().filter(|_| emit);
+        let material = shape.material.map(|m| m as u32);
+        let to_world = transform_of(m);
+        let params = &p.params;
+        let mut prims: Vec<PrimKind> = Vec::new();
+        match kind {
+            "trianglemesh" | "plymesh" => {
+                let Some(mesh) = &shape.mesh else {
+                    return Ok(());
+                };
+                let tm = TriangleMesh::from_mesh(mesh, &to_world, shape.reverse_orientation);
+                let mesh_index = geom.meshes.len() as u32;
+                let n = tm.indices.len() / 3;
+                geom.meshes.push(tm);
+                prims.extend((0..n as u32).map(|tri| PrimKind::Triangle {
+                    mesh: mesh_index,
+                    tri,
+                }));
+                // Parameters pbrt-v3 reads for meshes that acr has no use for.
+                for unused in ["alpha", "shadowalpha", "S", "faceIndices"] {
+                    if let Some(x) = params.get(unused) {
+                        self.warn_once(
+                            format!("mesh param {unused}"),
+                            &x.loc,
+                            format!("mesh parameter \"{unused}\" is not supported; ignored"),
+                        );
+                    }
+                }
+            }
+            "loopsubdiv" => {
+                let mesh =
+                    crate::shapes::loopsubdiv::mesh_from_params(params, &p.loc, self.warnings)?;
+                let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
+                let mesh_index = geom.meshes.len() as u32;
+                let n = tm.indices.len() / 3;
+                geom.meshes.push(tm);
+                prims.extend((0..n as u32).map(|tri| PrimKind::Triangle {
+                    mesh: mesh_index,
+                    tri,
+                }));
+            }
+            "sphere" => {
+                let r = params.float_or("radius", 1.0)? as f32;
+                let s = Sphere::new(
+                    r,
+                    params.float_or("zmin", -r as f64)? as f32,
+                    params.float_or("zmax", r as f64)? as f32,
+                    params.float_or("phimax", 360.0)? as f32,
+                    to_world,
+                    shape.reverse_orientation,
+                );
+                prims.push(PrimKind::Sphere(geom.spheres.len() as u32));
+                geom.spheres.push(s);
+            }
+            "disk" => {
+                let d = Disk::new(
+                    params.float_or("height", 0.0)? as f32,
+                    params.float_or("radius", 1.0)? as f32,
+                    params.float_or("innerradius", 0.0)? as f32,
+                    params.float_or("phimax", 360.0)? as f32,
+                    to_world,
+                    shape.reverse_orientation,
+                );
+                prims.push(PrimKind::Disk(geom.disks.len() as u32));
+                geom.disks.push(d);
+            }
+            "cylinder" => {
+                let c = Cylinder::new(
+                    params.float_or("radius", 1.0)? as f32,
+                    params.float_or("zmin", -1.0)? as f32,
+                    params.float_or("zmax", 1.0)? as f32,
+                    params.float_or("phimax", 360.0)? as f32,
+                    to_world,
+                    shape.reverse_orientation,
+                );
+                prims.push(PrimKind::Cylinder(geom.cylinders.len() as u32));
+                geom.cylinders.push(c);
+            }
+            other => {
+                self.warn_once(
+                    format!("shape {other}"),
+                    &p.loc,
+                    format!("unknown shape \"{other}\"; shapes of this type are skipped"),
+                );
+                return Ok(());
+            }
+        }
+        if area_light.is_none() {
+            let surface = self.surface(Surface {
+                material,
+                area_light: None,
+            });
+            for kind in prims {
+                geom.push(Prim { kind, surface });
+            }
+            return Ok(());
+        }
+        let light = area_light.cloned();
+        for kind in prims {
+            // One light per primitive, as pbrt-v3 makes one DiffuseAreaLight per shape.
+            let surface = self.surface(Surface {
+                material,
+                area_light: None,
+            });
+            if let Some(l) = &light {
+                self.area_lights.push((Arc::clone(l), kind, surface));
+            }
+            geom.push(Prim { kind, surface });
+        }
+        Ok(())
+    }
+
+    fn light(
+        &mut self,
+        p: &PluginDesc,
+        world_from_light: &DMat4,
+        world_radius: f32,
+        main_dir: &Path,
+    ) -> Result<Option<Light>> {
+        let params = &p.params;
+        let scale = rgb_param(params, "scale", Spectrum::ONE)?;
+        let m = world_from_light.as_mat4();
+        Ok(Some(match p.kind.as_str() {
+            "point" => {
+                let from = vec3_param(params, "from", Vec3::ZERO)?;
+                Light::Point {
+                    pos: m.transform_point3(from),
+                    intensity: rgb_param(params, "I", Spectrum::ONE)? * scale,
+                }
+            }
+            "spot" => {
+                let from = vec3_param(params, "from", Vec3::ZERO)?;
+                let to = vec3_param(params, "to", Vec3::Z)?;
+                let cone = params.float_or("coneangle", 30.0)? as f32;
+                let delta = params.float_or("conedelta", 5.0)? as f32;
+                let pos = m.transform_point3(from);
+                let dir = m.transform_vector3(to - from).normalize_or_zero();
+                if dir == Vec3::ZERO {
+                    return Err(Error::at(
+                        &p.loc,
+                        "spot light: \"from\" and \"to\" coincide",
+                    ));
+                }
+                Light::Spot {
+                    pos,
+                    light_from_world: spot_frame(dir),
+                    intensity: rgb_param(params, "I", Spectrum::ONE)? * scale,
+                    cos_total: cone.to_radians().cos(),
+                    cos_falloff_start: (cone - delta).to_radians().cos(),
+                }
+            }
+            "distant" => {
+                let from = vec3_param(params, "from", Vec3::ZERO)?;
+                let to = vec3_param(params, "to", Vec3::Z)?;
+                let w = m.transform_vector3(from - to).normalize_or_zero();
+                if w == Vec3::ZERO {
+                    return Err(Error::at(
+                        &p.loc,
+                        "distant light: \"from\" and \"to\" coincide",
+                    ));
+                }
+                Light::Distant {
+                    w,
+                    radiance: rgb_param(params, "L", Spectrum::ONE)? * scale,
+                    world_radius,
+                }
+            }
+            "infinite" => {
+                let l = rgb_param(params, "L", Spectrum::ONE)? * scale;
+                let _ = params.int("samples")?;
+                let _ = params.int("nsamples")?;
+                let map = match params.string("mapname")? {
+                    Some(name) if !name.is_empty() => {
+                        let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
+                        let path = crate::texture::resolve_file(name, loc, main_dir);
+                        let img = crate::image_io::read_image(&path, false)
+                            .map_err(|e| Error::at(loc, format!("cannot read \"{name}\": {e}")))?;
+                        Some(EnvMap::new(Arc::new(img)))
+                    }
+                    // pbrt-v3 gives a constant environment a 1x1 map and samples it through
+                    // the map's distribution (uniform in (phi, theta), denser at the poles);
+                    // doing the same keeps the variance, and the spatial light choice, as
+                    // pbrt-v3 has them.
+                    _ => Some(EnvMap::new(Arc::new(crate::image_io::RgbImage {
+                        width: 1,
+                        height: 1,
+                        pixels: vec![Spectrum::ONE],
+                    }))),
+                };
+                Light::Infinite {
+                    l,
+                    map,
+                    light_from_world: m.inverse(),
+                    world_from_light: m,
+                    world_radius,
+                }
+            }
+            "goniometric" | "projection" => {
+                self.warn_once(
+                    format!("light {}", p.kind),
+                    &p.loc,
+                    format!("light \"{}\" is not supported; skipped", p.kind),
+                );
+                return Ok(None);
+            }
+            other => {
+                let hint = acr_parser::closest(other, ["point", "spot", "distant", "infinite"])
+                    .map_or(String::new(), |k| format!(" (did you mean {k}?)"));
+                return Err(Error::at(
+                    &p.loc,
+                    format!("unknown light \"{other}\"{hint}"),
+                ));
+            }
+        }))
+    }
+}
+
+/// An RGB-valued parameter (rgb, spectrum or blackbody) or its default.
+pub fn rgb_param(params: &ParamList, name: &str, default: Spectrum) -> Result<Spectrum> {
+    Ok(crate::texture::spectrum_value(params, name)?.unwrap_or(default))
+}
+
+fn vec3_param(params: &ParamList, name: &str, default: Vec3) -> Result<Vec3> {
+    let Some(p) = params.get(name) else {
+        return Ok(default);
+    };
+    let v = match p.ty {
+        ParamType::Point3 | ParamType::Vector3 | ParamType::Normal => params.vec3(name, p.ty)?,
+        _ => return Err(Error::at(&p.loc, format!("\"{name}\" must be a point3"))),
+    };
+    Ok(v.map_or(default, |a| {
+        Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    }))
+}
+
+impl Scene {
+    /// Builds the scene from its description. Warnings (unsupported features, unused
+    /// parameters) are appended to `warnings`.
+    pub fn build(desc: &SceneDescription, warnings: &mut Vec<Warning>) -> Result<Scene> {
+        let main_dir = desc
+            .files
+            .first()
+            .map(|f| f.dir().to_path_buf())
+            .unwrap_or_default();
+        let Some(camera_desc) = &desc.camera else {
+            let path = desc
+                .files
+                .first()
+                .map(|f| f.path.clone())
+                .unwrap_or_default();
+            return Err(Error::file(path, "the scene has no Camera"));
+        };
+        let film = FilmSettings::new(desc.film.as_ref())?;
+        let camera = Camera::new(camera_desc, film.resolution)?;
+        let mut b = Builder {
+            desc,
+            warnings,
+            warned: HashSet::new(),
+            surfaces: Vec::new(),
+            lights: Vec::new(),
+            area_lights: Vec::new(),
+        };
+        let mut accel = Accel::default();
+        let mut world = Geometry::default();
+        for shape in &desc.shapes {
+            let moving = shape.world_from_object.is_animated()
+                && shape.world_from_object.end_time > shape.world_from_object.start_time;
+            if moving {
+                if let Some(al) = &shape.area_light {
+                    b.warn_once(
+                        "moving area light".into(),
+                        &al.loc,
+                        "area lights on moving shapes are not supported (as in pbrt-v3); \
+                         the shape does not emit"
+                            .into(),
+                    );
+                }
+                let mut g = Geometry::default();
+                b.add_shape(&mut g, shape, &DMat4::IDENTITY, false)?;
+                accel.objects.push(g);
+                accel.instances.push(Instance {
+                    object: (accel.objects.len() - 1) as u32,
+                    placement: Placement::Moving(Box::new(MotionTransform::new(
+                        &shape.world_from_object,
+                    ))),
+                });
+            } else {
+                b.add_shape(&mut world, shape, &shape.world_from_object.start, true)?;
+            }
+        }
+        let first_object = accel.objects.len() as u32;
+        for object in b.desc.objects.values() {
+            let mut g = Geometry::default();
+            for shape in &object.shapes {
+                if shape.world_from_object.is_animated() {
+                    b.warn_once(
+                        "animated in object".into(),
+                        &shape.plugin.loc,
+                        "motion inside an object definition is not supported; the shape is \
+                         placed at its start transform (move the instance instead)"
+                            .into(),
+                    );
+                }
+                b.add_shape(&mut g, shape, &shape.world_from_object.start, false)?;
+            }
+            accel.objects.push(g);
+        }
+        for inst in &desc.instances {
+            let t = &inst.world_from_instance;
+            let placement = if t.is_animated() && t.end_time > t.start_time {
+                Placement::Moving(Box::new(MotionTransform::new(t)))
+            } else {
+                Placement::Fixed {
+                    to_world: t.start.as_mat4(),
+                    to_local: t.start.inverse().as_mat4(),
+                }
+            };
+            accel.instances.push(Instance {
+                object: first_object + inst.object as u32,
+                placement,
+            });
+        }
+        accel.world = world;
+        accel.build();
+        let (lo, hi) = accel.bounds();
+        let (world_center, world_radius) = if lo.cmple(hi).all() {
+            ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+        } else {
+            (Vec3::ZERO, 1.0)
+        };
+        // Area lights, now that the world geometry has its final layout.
+        for (light, kind, surface) in std::mem::take(&mut b.area_lights) {
+            if !matches!(light.kind.as_str(), "area" | "diffuse") {
+                return Err(Error::at(
+                    &light.loc,
+                    format!(
+                        "area light \"{}\" is not supported (only \"diffuse\")",
+                        light.kind
+                    ),
+                ));
+            }
+            let params = &light.params;
+            let l_emit =
+                rgb_param(params, "L", Spectrum::ONE)? * rgb_param(params, "scale", Spectrum::ONE)?;
+            let two_sided = params.bool_or("twosided", false)?;
+            let _ = params.int("nsamples")?;
+            let _ = params.int("samples")?;
+            let area = prim_area(&accel.world, kind);
+            if area > 0.0 && l_emit.max_element() > 0.0 {
+                b.lights.push(Light::Area {
+                    shape: AreaShape { kind },
+                    l_emit,
+                    two_sided,
+                    area,
+                });
+                b.surfaces[surface as usize].area_light = Some((b.lights.len() - 1) as u32);
+            }
+        }
+        for l in &desc.lights {
+            if let Some(light) = b.light(&l.plugin, &l.world_from_light, world_radius, &main_dir)? {
+                b.lights.push(light);
+            }
+        }
+        let materials = crate::material::build_materials(desc, &main_dir, b.warnings)?;
+        let powers: Vec<f32> = b
+            .lights
+            .iter()
+            .map(|l| crate::spectrum_luminance(l.power()))
+            .collect();
+        let infinite_lights = b
+            .lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| matches!(l, Light::Infinite { .. }))
+            .map(|(i, _)| i as u32)
+            .collect();
+        let dims = Dims {
+            time: (accel.has_motion() || camera.is_moving())
+                && camera.shutter_close > camera.shutter_open,
+            lens: camera.lens_radius > 0.0,
+        };
+        Ok(Scene {
+            camera,
+            film,
+            accel,
+            light_choice: LightChoices {
+                uniform: Distribution1D::new(&vec![1.0; powers.len()]),
+                power: Distribution1D::new(&powers),
+                spatial: OnceLock::new(),
+                bounds: (lo, hi),
+            },
+            lights: b.lights,
+            infinite_lights,
+            materials,
+            surfaces: b.surfaces,
+            dims,
+            world_center,
+            world_radius,
+        })
+    }
+}
