@@ -7,7 +7,9 @@
 //! builds no TLAS and no motion structures. Shadow rays stop at the first hit.
 
 use crate::geometry::{Ray, SurfaceInteraction, Vec3};
-use crate::shapes::triangle::{intersect_triangle, triangle_bounds, triangle_interaction};
+use crate::shapes::triangle::{
+    intersect_triangle_vertices, triangle_bounds, triangle_interaction, TriangleRay,
+};
 use crate::shapes::{Cylinder, Disk, Sphere, TriangleMesh};
 use crate::transform::MotionTransform;
 use glam::{Mat4, Vec3A};
@@ -56,6 +58,9 @@ pub struct Geometry {
     pub cylinders: Vec<Cylinder>,
     /// Primitives in BVH leaf order.
     prims: Vec<Prim>,
+    /// The vertices of each triangle primitive, in leaf order beside `prims` (zeros for other
+    /// kinds): the traversal reads one contiguous record instead of three indirections.
+    tri_verts: Vec<[Vec3; 3]>,
     bvh: Option<CwBvh>,
 }
 
@@ -81,7 +86,11 @@ pub struct Hit {
 }
 
 fn to_obvhs(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
-    obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(ray.d), 0.0, t_max)
+    // `+ 0.0` turns -0.0 components into +0.0: obvhs's traversal misses some axis-aligned
+    // rays whose direction has a negative zero (measured: direction -Z missed a triangle
+    // straight ahead that +0.0 components hit).
+    let d = ray.d + Vec3::ZERO;
+    obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(d), 0.0, t_max)
 }
 
 impl Geometry {
@@ -148,14 +157,31 @@ impl Geometry {
             .iter()
             .map(|&i| self.prims[i as usize])
             .collect();
+        self.tri_verts = self
+            .prims
+            .iter()
+            .map(|p| match p.kind {
+                PrimKind::Triangle { mesh, tri } => {
+                    self.meshes[mesh as usize].vertices(tri as usize)
+                }
+                _ => [Vec3::ZERO; 3],
+            })
+            .collect();
         self.bvh = Some(bvh);
     }
 
+    /// Intersects primitive `id` (a leaf-order index).
     #[inline]
-    fn intersect_prim(&self, p: &Prim, ray: &Ray, t_max: f32) -> Option<(f32, LocalHit)> {
-        match p.kind {
-            PrimKind::Triangle { mesh, tri } => {
-                intersect_triangle(&self.meshes[mesh as usize], tri as usize, ray, t_max)
+    fn intersect_prim(
+        &self,
+        id: usize,
+        ray: &Ray,
+        tri_ray: &TriangleRay,
+        t_max: f32,
+    ) -> Option<(f32, LocalHit)> {
+        match self.prims[id].kind {
+            PrimKind::Triangle { .. } => {
+                intersect_triangle_vertices(&self.tri_verts[id], tri_ray, t_max)
                     .map(|h| (h.t, LocalHit::Triangle(h)))
             }
             PrimKind::Sphere(i) => self.spheres[i as usize]
@@ -175,9 +201,10 @@ impl Geometry {
         let bvh = self.bvh.as_ref()?;
         let mut best: Option<Hit> = None;
         let mut hit = obvhs::ray::RayHit::none();
+        let tri_ray = TriangleRay::new(ray);
         bvh.ray_traverse(to_obvhs(ray, t_max), &mut hit, |r, id| {
             let prim = &self.prims[id];
-            match self.intersect_prim(prim, ray, r.tmax) {
+            match self.intersect_prim(id, ray, &tri_ray, r.tmax) {
                 Some((t, local)) => {
                     best = Some(Hit {
                         t,
@@ -198,8 +225,9 @@ impl Geometry {
         let Some(bvh) = &self.bvh else {
             return false;
         };
+        let tri_ray = TriangleRay::new(ray);
         !bvh.ray_traverse_miss(to_obvhs(ray, t_max), |r, id| {
-            self.intersect_prim(&self.prims[id], ray, r.tmax)
+            self.intersect_prim(id, ray, &tri_ray, r.tmax)
                 .map_or(f32::INFINITY, |(t, _)| t)
         })
     }

@@ -318,7 +318,11 @@ impl Bxdf {
                     return Spectrum::ZERO;
                 }
                 let wh = wh.normalize();
-                let fr = fresnel.evaluate(wi.dot(wh));
+                // The half vector faced forward, as pbrt-v3 has done since its issue #254: with
+                // a shading normal facing away from the viewer, Dot(wi, wh) is negative and a
+                // dielectric Fresnel term would swap its indices.
+                let wh_forward = if wh.z < 0.0 { -wh } else { wh };
+                let fr = fresnel.evaluate(wi.dot(wh_forward));
                 r * distribution.d(wh) * distribution.g(wo, wi) * fr / (4.0 * cos_i * cos_o)
             }
             Bxdf::MicrofacetTransmission {

@@ -5,6 +5,9 @@ use crate::geometry::{Spectrum, Vec2};
 use acr_parser::{Error, PluginDesc, Result};
 use acr_plugins::{FilterKernel, Kernel};
 
+/// Entries per axis of the filter table (pbrt-v3's filterTableWidth).
+const TABLE_SIZE: usize = 16;
+
 /// Largest accepted resolution per axis: keeps a typo from allocating terabytes.
 pub const MAX_RESOLUTION: u32 = 1 << 15;
 
@@ -96,18 +99,85 @@ impl FilmSettings {
 #[derive(Clone, Debug)]
 pub struct Film {
     settings: FilmSettings,
-    kernel: Kernel,
+    splat: Splat,
     sums: Vec<[f64; 4]>,
+}
+
+/// How one sample spreads over a film row: the kernel tabulated over one quadrant of its
+/// support, as pbrt-v3 does (evaluating exp() or a polynomial for each of a sample's up to 25
+/// pixels would cost more than tracing it), the radius and the crop's columns.
+#[derive(Clone, Debug)]
+struct Splat {
+    table: [f32; TABLE_SIZE * TABLE_SIZE],
+    radius: (f32, f32),
+    columns: (i64, i64),
+    max_luminance: f32,
+}
+
+impl Splat {
+    /// Adds the contributions of the sample at `p` to film row `y` (`row` is its pixels).
+    #[inline]
+    fn row(&self, row: &mut [[f64; 4]], y: i64, p: Vec2, l: Spectrum) {
+        let (rx, ry) = self.radius;
+        let (cx0, cx1) = self.columns;
+        let (dx, dy) = (p.x - 0.5, p.y - 0.5);
+        let ay = (y as f32 - dy).abs();
+        if ay > ry {
+            return;
+        }
+        let fy = ((ay / ry * TABLE_SIZE as f32) as usize).min(TABLE_SIZE - 1);
+        let table_row = &self.table[fy * TABLE_SIZE..][..TABLE_SIZE];
+        let x0 = ((dx - rx).ceil() as i64).max(cx0);
+        let x1 = ((dx + rx).floor() as i64 + 1).min(cx1);
+        for x in x0..x1 {
+            let fx = ((x as f32 - dx).abs() / rx * TABLE_SIZE as f32) as usize;
+            let weight = table_row[fx.min(TABLE_SIZE - 1)];
+            if weight != 0.0 {
+                let s = &mut row[(x - cx0) as usize];
+                let wf = weight as f64;
+                s[0] += wf * l.x as f64;
+                s[1] += wf * l.y as f64;
+                s[2] += wf * l.z as f64;
+                s[3] += wf;
+            }
+        }
+    }
+
+    /// The radiance after the film's luminance clamp (pbrt-v3's maxsampleluminance).
+    #[inline]
+    fn clamped(&self, l: Spectrum) -> Spectrum {
+        let lum = crate::spectrum_luminance(l);
+        if lum > self.max_luminance {
+            l * (self.max_luminance / lum)
+        } else {
+            l
+        }
+    }
 }
 
 impl Film {
     /// An empty film.
     pub fn new(settings: FilmSettings, kernel: Kernel) -> Self {
         let (w, h) = settings.size();
+        let (rx, ry) = kernel.radius();
+        let mut table = [0.0f32; TABLE_SIZE * TABLE_SIZE];
+        for (i, t) in table.iter_mut().enumerate() {
+            let (x, y) = (i % TABLE_SIZE, i / TABLE_SIZE);
+            *t = kernel.eval(
+                (x as f32 + 0.5) * rx / TABLE_SIZE as f32,
+                (y as f32 + 0.5) * ry / TABLE_SIZE as f32,
+            );
+        }
+        let [cx0, cx1, _, _] = settings.crop;
         Self {
             sums: vec![[0.0; 4]; w as usize * h as usize],
+            splat: Splat {
+                table,
+                radius: (rx, ry),
+                columns: (cx0 as i64, cx1 as i64),
+                max_luminance: settings.max_sample_luminance,
+            },
             settings,
-            kernel,
         }
     }
 
@@ -117,38 +187,58 @@ impl Film {
     }
 
     /// Adds a sample at raster position `p` (full-resolution pixels) with radiance `l`, into
-    /// every pixel whose centre is within the filter radius (pbrt-v3's Film::AddSample).
-    #[inline]
+    /// every pixel whose centre is within the filter radius (pbrt-v3's Film::AddSample, with
+    /// its tabulated filter).
     pub fn add_sample(&mut self, p: Vec2, l: Spectrum) {
-        let (rx, ry) = self.kernel.radius();
-        let [cx0, cx1, cy0, cy1] = self.settings.crop;
-        let (dx, dy) = (p.x - 0.5, p.y - 0.5);
-        let x0 = ((dx - rx).ceil() as i64).max(cx0 as i64);
-        let x1 = ((dx + rx).floor() as i64 + 1).min(cx1 as i64);
+        let [_, _, cy0, cy1] = self.settings.crop;
+        let ry = self.splat.radius.1;
+        let dy = p.y - 0.5;
         let y0 = ((dy - ry).ceil() as i64).max(cy0 as i64);
         let y1 = ((dy + ry).floor() as i64 + 1).min(cy1 as i64);
-        let w = (cx1 - cx0) as i64;
-        let lum = crate::spectrum_luminance(l);
-        let l = if lum > self.settings.max_sample_luminance {
-            l * (self.settings.max_sample_luminance / lum)
-        } else {
-            l
-        };
+        let l = self.splat.clamped(l);
+        let w = self.settings.size().0 as usize;
         for y in y0..y1 {
-            let fy = y as f32 - dy;
-            for x in x0..x1 {
-                let weight = self.kernel.eval(x as f32 - dx, fy);
-                if weight != 0.0 {
-                    let i = ((y - cy0 as i64) * w + (x - cx0 as i64)) as usize;
-                    let s = &mut self.sums[i];
-                    let wf = weight as f64;
-                    s[0] += wf * l.x as f64;
-                    s[1] += wf * l.y as f64;
-                    s[2] += wf * l.z as f64;
-                    s[3] += wf;
-                }
-            }
+            let start = (y - cy0 as i64) as usize * w;
+            self.splat.row(&mut self.sums[start..start + w], y, p, l);
         }
+    }
+
+    /// Adds samples in order: each pixel receives its contributions in the order given, so the
+    /// result equals adding them one by one, whatever the thread count. The samples must be
+    /// sorted by raster row (`floor(p.y)`), as the render loop produces them; rows are then
+    /// filled in parallel, each from the samples within the filter's reach.
+    pub fn add_samples(&mut self, samples: &[(Vec2, Spectrum)]) {
+        use rayon::prelude::*;
+        debug_assert!(samples
+            .windows(2)
+            .all(|w| w[0].0.y.floor() <= w[1].0.y.floor()));
+        let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
+            return;
+        };
+        let cy0 = self.settings.crop[2] as i64;
+        let ry = self.splat.radius.1;
+        // Sorted by whole rows only: the extreme positions are bounded by the rows' edges.
+        let (lo, hi) = (first.0.y.floor() - 0.5 - ry, last.0.y.floor() + 0.5 + ry);
+        let w = self.settings.size().0 as usize;
+        let splat = &self.splat;
+        self.sums
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(row_index, row)| {
+                let y = row_index as i64 + cy0;
+                let yf = y as f32;
+                if yf < lo || yf > hi {
+                    return;
+                }
+                // A superset, by whole raster rows (monotone in the sorted samples), of the
+                // samples whose filter reaches row y (|y - (p.y - 0.5)| <= ry).
+                let (top, bottom) = ((yf + 0.5 - ry).floor(), (yf + 0.5 + ry).floor());
+                let from = samples.partition_point(|(p, _)| p.y.floor() < top);
+                let to = samples.partition_point(|(p, _)| p.y.floor() <= bottom);
+                for &(p, l) in &samples[from..to] {
+                    splat.row(row, y, p, splat.clamped(l));
+                }
+            });
     }
 
     /// The image: each pixel's weighted mean times the film scale, row-major, top row first.
@@ -192,6 +282,36 @@ mod tests {
         let p = f.pixels();
         assert_eq!(p[0], Spectrum::splat(2.0));
         assert_eq!(p[1], Spectrum::splat(5.0));
+    }
+
+    #[test]
+    fn batch_adding_equals_one_by_one() {
+        use acr_plugins::filters::MitchellFilter;
+        let kernel = Kernel::Mitchell(MitchellFilter::new(2.0, 1.5, 1.0 / 3.0, 1.0 / 3.0));
+        let mut s = FilmSettings::with_resolution(9, 7);
+        s.crop = [1, 8, 1, 6];
+        let mut one = Film::new(s.clone(), kernel.clone());
+        let mut batch = Film::new(s, kernel);
+        // Row-sorted samples, several per pixel, with varied values.
+        let mut samples = Vec::new();
+        for py in 0..7u32 {
+            for px in 0..9u32 {
+                for k in 0..3u32 {
+                    let u = Vec2::new(
+                        (k as f32 * 0.37 + px as f32 * 0.11) % 1.0,
+                        (k as f32 * 0.61) % 1.0,
+                    );
+                    let l = Spectrum::new(px as f32, py as f32, k as f32 + 1.0);
+                    samples.push((Vec2::new(px as f32, py as f32) + u, l));
+                }
+            }
+        }
+        for &(p, l) in &samples {
+            one.add_sample(p, l);
+        }
+        batch.add_samples(&samples[..100]);
+        batch.add_samples(&samples[100..]);
+        assert_eq!(one.pixels(), batch.pixels());
     }
 
     #[test]

@@ -223,7 +223,7 @@ fn path_li(
     let mut prev_bsdf_pdf = 0.0f32;
     // The light distribution at the previous scattering point, for the MIS weight of emission
     // that the BSDF sample finds.
-    let mut prev_choice: Option<&crate::sampling::Distribution1D> = None;
+    let mut prev_choice: Option<&crate::lightdistrib::LightPmf> = None;
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
     loop {
@@ -235,7 +235,7 @@ fn path_li(
                 if depth == 0 || specular_bounce {
                     l += beta * le;
                 } else {
-                    let choice = prev_choice.map_or(0.0, |d| d.discrete_pdf(i as usize));
+                    let choice = prev_choice.map_or(0.0, |d| d.pdf(i as usize));
                     let light_pdf = choice * light.pdf_le(ray.d.normalize());
                     l += beta * le * power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
                 }
@@ -250,7 +250,7 @@ fn path_li(
                 if depth == 0 || specular_bounce {
                     l += beta * le;
                 } else {
-                    let choice = prev_choice.map_or(0.0, |d| d.discrete_pdf(li as usize));
+                    let choice = prev_choice.map_or(0.0, |d| d.pdf(li as usize));
                     let light_pdf =
                         choice * light.pdf_area_hit(&scene.accel.world, prev_p, si.p, si.n);
                     l += beta * le * power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
@@ -273,7 +273,7 @@ fn path_li(
         if have_lights && bsdf.has_non_specular() {
             let choice = scene.light_choice(light_strategy, si.p);
             prev_choice = Some(choice);
-            let (light_index, choice_pdf, _) = choice.sample_discrete(stream.next_1d());
+            let (light_index, choice_pdf) = choice.sample(stream.next_1d());
             l += beta
                 * sample_light(
                     scene,
@@ -374,7 +374,7 @@ fn direct_li(
             }
             DirectStrategy::One => {
                 let choice = scene.light_choice(LightStrategy::Uniform, si.p);
-                let (i, pdf, _) = choice.sample_discrete(stream.next_1d());
+                let (i, pdf) = choice.sample(stream.next_1d());
                 l += estimate_direct(scene, &si, &bsdf, i as u32, pdf, stream, rays);
             }
         }

@@ -6,7 +6,6 @@
 use crate::accel::Geometry;
 use crate::geometry::{Vec2, Vec3};
 use crate::light::Light;
-use crate::sampling::Distribution1D;
 use std::sync::OnceLock;
 
 /// pbrt-v3's `lightsamplestrategy`.
@@ -32,6 +31,78 @@ impl LightStrategy {
     }
 }
 
+/// A discrete distribution over the lights, in one allocation (the cdf's n + 1 values, then
+/// each light's probability), so that choosing a light touches one or two cache lines.
+#[derive(Clone, Debug)]
+pub struct LightPmf(Box<[f32]>);
+
+impl LightPmf {
+    /// From non-negative weights (negative or non-finite ones count as 0; all zero: uniform).
+    pub fn new(weights: &[f32]) -> Self {
+        let n = weights.len();
+        let clean = |w: f32| {
+            if w.is_finite() && w > 0.0 {
+                w as f64
+            } else {
+                0.0
+            }
+        };
+        let total: f64 = weights.iter().map(|&w| clean(w)).sum();
+        let prob = |w: f32| {
+            if total > 0.0 {
+                clean(w) / total
+            } else {
+                1.0 / n.max(1) as f64
+            }
+        };
+        let mut v = Vec::with_capacity(2 * n + 1);
+        let mut acc = 0.0f64;
+        v.push(0.0);
+        for &w in weights {
+            acc += prob(w);
+            v.push(acc as f32);
+        }
+        if n > 0 {
+            v[n] = 1.0;
+        }
+        v.extend(weights.iter().map(|&w| prob(w) as f32));
+        Self(v.into_boxed_slice())
+    }
+
+    /// Number of lights.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.0.len() / 2
+    }
+
+    /// True when there are no lights.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Chooses a light with `u` in [0, 1): its index and probability.
+    #[inline]
+    pub fn sample(&self, u: f32) -> (usize, f32) {
+        let n = self.len();
+        let cdf = &self.0[..=n];
+        // The last piece whose start is <= u (pieces of zero width are skipped).
+        let i = cdf.partition_point(|&c| c <= u).clamp(1, n.max(1)) - 1;
+        (i, self.pdf(i))
+    }
+
+    /// Probability of choosing light `i`.
+    #[inline]
+    pub fn pdf(&self, i: usize) -> f32 {
+        let n = self.len();
+        if i < n {
+            self.0[n + 1 + i]
+        } else {
+            0.0
+        }
+    }
+}
+
 /// Voxels along the scene's longest axis (pbrt-v3's value).
 const MAX_VOXELS: f32 = 64.0;
 /// Points per voxel at which every light is sampled (pbrt-v3's value).
@@ -53,7 +124,7 @@ pub struct SpatialLightDistribution {
     lo: Vec3,
     extent: Vec3,
     n: [u32; 3],
-    voxels: Vec<OnceLock<Distribution1D>>,
+    voxels: Vec<OnceLock<LightPmf>>,
 }
 
 impl SpatialLightDistribution {
@@ -83,7 +154,7 @@ impl SpatialLightDistribution {
     }
 
     /// The distribution for the voxel holding `p`.
-    pub fn lookup(&self, p: Vec3, lights: &[Light], world: &Geometry) -> &Distribution1D {
+    pub fn lookup(&self, p: Vec3, lights: &[Light], world: &Geometry) -> &LightPmf {
         let mut cell = [0u32; 3];
         for (i, c) in cell.iter_mut().enumerate() {
             let offset = if self.extent[i] > 0.0 {
@@ -103,7 +174,7 @@ impl SpatialLightDistribution {
     /// weighted by luminance(Li) / pdf without visibility (environments scaled by
     /// [`INFINITE_LIGHT_WEIGHT`]), with a floor of 0.1% of the mean so that no light is ever
     /// impossible.
-    fn compute(&self, cell: [u32; 3], lights: &[Light], world: &Geometry) -> Distribution1D {
+    fn compute(&self, cell: [u32; 3], lights: &[Light], world: &Geometry) -> LightPmf {
         let corner = |k: u32| -> Vec3 {
             Vec3::new(
                 (cell[0] + k) as f32 / self.n[0] as f32,
@@ -144,7 +215,7 @@ impl SpatialLightDistribution {
         for c in &mut contrib {
             *c = c.max(floor);
         }
-        Distribution1D::new(&contrib)
+        LightPmf::new(&contrib)
     }
 }
 
@@ -163,7 +234,7 @@ pub fn radical_inverse(base: u32, mut i: u32) -> f32 {
 /// The light choice of a scene under one strategy.
 pub enum LightDistribution {
     /// One distribution everywhere (uniform or power).
-    Global(Distribution1D),
+    Global(LightPmf),
     /// One per voxel.
     Spatial(SpatialLightDistribution),
 }
@@ -173,11 +244,11 @@ impl LightDistribution {
     /// spatial grid: every strategy picks the one light.
     pub fn new(strategy: LightStrategy, lights: &[Light], bounds: (Vec3, Vec3)) -> Self {
         match strategy {
-            LightStrategy::Uniform => Self::Global(Distribution1D::new(&vec![1.0; lights.len()])),
+            LightStrategy::Uniform => Self::Global(LightPmf::new(&vec![1.0; lights.len()])),
             LightStrategy::Spatial if lights.len() > 1 => {
                 Self::Spatial(SpatialLightDistribution::new(bounds.0, bounds.1))
             }
-            _ => Self::Global(Distribution1D::new(
+            _ => Self::Global(LightPmf::new(
                 &lights
                     .iter()
                     .map(|l| crate::spectrum_luminance(l.power()))
@@ -188,7 +259,7 @@ impl LightDistribution {
 
     /// The distribution to choose a light with at `p`.
     #[inline]
-    pub fn lookup(&self, p: Vec3, lights: &[Light], world: &Geometry) -> &Distribution1D {
+    pub fn lookup(&self, p: Vec3, lights: &[Light], world: &Geometry) -> &LightPmf {
         match self {
             Self::Global(d) => d,
             Self::Spatial(s) => s.lookup(p, lights, world),
@@ -210,6 +281,22 @@ mod tests {
     }
 
     #[test]
+    fn pmf_samples_in_proportion() {
+        let pmf = LightPmf::new(&[1.0, 0.0, 3.0, f32::NAN]);
+        assert_eq!(pmf.len(), 4);
+        assert_eq!(pmf.pdf(0), 0.25);
+        assert_eq!(pmf.pdf(1), 0.0);
+        assert_eq!(pmf.pdf(2), 0.75);
+        assert_eq!(pmf.pdf(3), 0.0);
+        assert_eq!(pmf.sample(0.0), (0, 0.25));
+        assert_eq!(pmf.sample(0.249), (0, 0.25));
+        assert_eq!(pmf.sample(0.25), (2, 0.75));
+        assert_eq!(pmf.sample(0.999_999), (2, 0.75));
+        let uniform = LightPmf::new(&[0.0, 0.0]);
+        assert_eq!(uniform.sample(0.7), (1, 0.5));
+    }
+
+    #[test]
     fn spatial_favours_the_near_light() {
         let lights = vec![
             Light::Point {
@@ -228,15 +315,11 @@ mod tests {
             (Vec3::splat(-10.0), Vec3::splat(10.0)),
         );
         let near_left = d.lookup(Vec3::new(-9.0, 0.0, 0.0), &lights, &world);
-        assert!(
-            near_left.discrete_pdf(0) > 0.9,
-            "{}",
-            near_left.discrete_pdf(0)
-        );
+        assert!(near_left.pdf(0) > 0.9, "{}", near_left.pdf(0));
         let near_right = d.lookup(Vec3::new(9.0, 0.0, 0.0), &lights, &world);
-        assert!(near_right.discrete_pdf(1) > 0.9);
+        assert!(near_right.pdf(1) > 0.9);
         // Every light stays possible.
-        assert!(near_right.discrete_pdf(0) > 0.0);
+        assert!(near_right.pdf(0) > 0.0);
         // Out of the bounds and NaN clamp to a voxel instead of failing.
         let _ = d.lookup(Vec3::splat(1e9), &lights, &world);
         let _ = d.lookup(Vec3::splat(f32::NAN), &lights, &world);

@@ -112,6 +112,16 @@ fn check_spp(spp: i64, loc: &acr_parser::Loc) -> Result<u32> {
     Ok(spp as u32)
 }
 
+/// The raster position of offset `u` in [0, 1)^2 within pixel (px, py). Rounding can carry
+/// `py + u.y` to `py + 1` (from row 1024 on, say); the result is kept inside the pixel, so that
+/// a sample always lands in the pixel it was drawn for and batches stay sorted by row.
+#[inline]
+pub fn in_pixel(px: u32, py: u32, u: Vec2) -> Vec2 {
+    let below = |i: u32| f32::from_bits((i as f32).to_bits() - 1);
+    let p = Vec2::new(px as f32, py as f32) + u;
+    p.min(Vec2::new(below(px + 1), below(py + 1)))
+}
+
 /// What a render produced besides the image.
 #[derive(Clone, Debug, Default)]
 pub struct RenderCounts {
@@ -155,7 +165,7 @@ pub fn render(
                 let py = y0 + (pixel / width) as u32;
                 let key = py as u64 * full_width + px as u64;
                 let mut stream = SampleStream::new(key, index, seed, 0);
-                let film_pos = Vec2::new(px as f32, py as f32) + stream.next_2d();
+                let film_pos = in_pixel(px, py, stream.next_2d());
                 let time = if dims.time { stream.next_1d() } else { 0.5 };
                 let lens = if dims.lens {
                     stream.next_2d()
@@ -171,14 +181,16 @@ pub fn render(
                 (film_pos, r.l, r.rays)
             })
             .collect();
+        let mut valid = Vec::with_capacity(results.len());
         for (pos, l, rays) in results {
             counts.rays += rays as u64;
             if is_valid_radiance(l) {
-                film.add_sample(pos, l);
+                valid.push((pos, l));
             } else {
                 counts.dropped += 1;
             }
         }
+        film.add_samples(&valid);
         counts.samples += (end - start) as u64;
         if let Some(p) = progress {
             p.set_position(end as u64);

@@ -6,9 +6,8 @@ use crate::camera::Camera;
 use crate::film::FilmSettings;
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3};
 use crate::light::{prim_area, spot_frame, AreaShape, EnvMap, Light};
-use crate::lightdistrib::{LightDistribution, LightStrategy};
+use crate::lightdistrib::{LightDistribution, LightPmf, LightStrategy};
 use crate::material::Material;
-use crate::sampling::Distribution1D;
 use crate::shapes::{Cylinder, Disk, Sphere, Transform, TriangleMesh};
 use crate::transform::MotionTransform;
 use acr_parser::{
@@ -111,7 +110,7 @@ impl Scene {
 
     /// The distribution to choose a light from at `p` under `strategy`.
     #[inline]
-    pub fn light_choice(&self, strategy: LightStrategy, p: Vec3) -> &Distribution1D {
+    pub fn light_choice(&self, strategy: LightStrategy, p: Vec3) -> &LightPmf {
         let c = &self.light_choice;
         match strategy {
             LightStrategy::Uniform => &c.uniform,
@@ -126,8 +125,8 @@ impl Scene {
 
 /// The light distributions of a scene.
 struct LightChoices {
-    uniform: Distribution1D,
-    power: Distribution1D,
+    uniform: LightPmf,
+    power: LightPmf,
     spatial: OnceLock<LightDistribution>,
     bounds: (Vec3, Vec3),
 }
@@ -578,8 +577,8 @@ impl Scene {
             film,
             accel,
             light_choice: LightChoices {
-                uniform: Distribution1D::new(&vec![1.0; powers.len()]),
-                power: Distribution1D::new(&powers),
+                uniform: LightPmf::new(&vec![1.0; powers.len()]),
+                power: LightPmf::new(&powers),
                 spatial: OnceLock::new(),
                 bounds: (lo, hi),
             },

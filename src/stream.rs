@@ -61,6 +61,11 @@ pub struct SampleStream {
     index: u32,
     scramble: u32,
     dim: u32,
+    /// The four Sobol dimensions of the set `dim / 4`, computed together (SIMD) on first use:
+    /// the same values `sobol_burley::sample` gives one at a time, at about a quarter the cost.
+    block: [f32; 4],
+    /// The set `block` holds, or `u32::MAX` for none.
+    block_set: u32,
     rng: Pcg32,
 }
 
@@ -73,6 +78,8 @@ impl SampleStream {
             index,
             scramble: key as u32,
             dim: first_dim,
+            block: [0.0; 4],
+            block_set: u32::MAX,
             rng: Pcg32::new(
                 key ^ u64::from(index),
                 mix64(key).wrapping_add(u64::from(index)),
@@ -86,7 +93,12 @@ impl SampleStream {
         let d = self.dim;
         self.dim += 1;
         if d < sobol_burley::NUM_DIMENSIONS {
-            sobol_burley::sample(self.index, d, self.scramble)
+            let set = d / 4;
+            if set != self.block_set {
+                self.block = sobol_burley::sample_4d(self.index, set, self.scramble);
+                self.block_set = set;
+            }
+            self.block[(d % 4) as usize]
         } else {
             self.rng.next_f32()
         }
@@ -111,6 +123,11 @@ mod tests {
             let x = a.next_1d();
             assert_eq!(x, b.next_1d());
             assert!((0.0..1.0).contains(&x));
+        }
+        // The same values as one dimension at a time.
+        let mut d = SampleStream::new(17, 3, 42, 5);
+        for dim in 5..40 {
+            assert_eq!(d.next_1d(), sobol_burley::sample(3, dim, d.scramble));
         }
         let mut c = SampleStream::new(18, 3, 42, 5);
         assert_ne!(SampleStream::new(17, 3, 42, 5).next_1d(), c.next_1d());

@@ -67,7 +67,7 @@ impl TriangleMesh {
 
     /// Vertex positions of triangle `tri`.
     #[inline]
-    fn vertices(&self, tri: usize) -> [Vec3; 3] {
+    pub fn vertices(&self, tri: usize) -> [Vec3; 3] {
         let [a, b, c] = self.vertex_indices(tri);
         [self.positions[a], self.positions[b], self.positions[c]]
     }
@@ -127,27 +127,60 @@ pub fn intersect_triangle(
     ray: &Ray,
     t_max: f32,
 ) -> Option<TriangleHit> {
-    let [p0, p1, p2] = mesh.vertices(tri);
+    intersect_triangle_vertices(&mesh.vertices(tri), &TriangleRay::new(ray), t_max)
+}
 
-    // Translate vertices based on the ray origin.
-    let mut p0t = p0 - ray.o;
-    let mut p1t = p1 - ray.o;
-    let mut p2t = p2 - ray.o;
+/// What the watertight test needs of a ray, computed once per ray rather than per triangle:
+/// its origin, the axis permutation that makes the largest direction component z, and the
+/// shear that maps the direction to +z.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay {
+    o: Vec3,
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
 
-    // Permute components of the vertices and the ray direction.
-    let kz = max_dimension(ray.d.abs());
-    let kx = if kz + 1 == 3 { 0 } else { kz + 1 };
-    let ky = if kx + 1 == 3 { 0 } else { kx + 1 };
+impl TriangleRay {
+    /// The per-ray constants of `ray`.
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let kz = max_dimension(ray.d.abs());
+        let kx = if kz + 1 == 3 { 0 } else { kz + 1 };
+        let ky = if kx + 1 == 3 { 0 } else { kx + 1 };
+        let d = Vec3::new(ray.d[kx], ray.d[ky], ray.d[kz]);
+        Self {
+            o: ray.o,
+            kx,
+            ky,
+            kz,
+            sx: -d.x / d.z,
+            sy: -d.y / d.z,
+            sz: 1.0 / d.z,
+        }
+    }
+}
+
+/// [`intersect_triangle`] on the triangle's three vertices and a prepared ray.
+#[inline]
+pub fn intersect_triangle_vertices(
+    p: &[Vec3; 3],
+    r: &TriangleRay,
+    t_max: f32,
+) -> Option<TriangleHit> {
+    let [p0, p1, p2] = *p;
+    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
     let permute = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
-    let d = permute(ray.d);
-    p0t = permute(p0t);
-    p1t = permute(p1t);
-    p2t = permute(p2t);
+    // Translate to the ray origin and permute.
+    let mut p0t = permute(p0 - r.o);
+    let mut p1t = permute(p1 - r.o);
+    let mut p2t = permute(p2 - r.o);
 
     // Shear so that the ray direction becomes +z.
-    let sx = -d.x / d.z;
-    let sy = -d.y / d.z;
-    let sz = 1.0 / d.z;
+    let (sx, sy, sz) = (r.sx, r.sy, r.sz);
     p0t.x += sx * p0t.z;
     p0t.y += sy * p0t.z;
     p1t.x += sx * p1t.z;
