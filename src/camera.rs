@@ -34,8 +34,13 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// Builds the camera from its description and the film's full resolution.
-    pub fn new(desc: &CameraDesc, resolution: (u32, u32)) -> Result<Self> {
+    /// Builds the camera from its description and the film's full resolution, placed in
+    /// render space by `render_from_world`.
+    pub fn new(
+        desc: &CameraDesc,
+        resolution: (u32, u32),
+        render_from_world: glam::DMat4,
+    ) -> Result<Self> {
         let p = &desc.plugin;
         if p.kind != "perspective" {
             return Err(Error::at(
@@ -95,8 +100,8 @@ impl Camera {
             * Mat4::from_translation(Vec3::new(-screen[0], -screen[3], 0.0));
         let raster_to_camera = camera_to_screen.inverse() * screen_to_raster.inverse();
         let inverse_motion = acr_parser::AnimatedTransform {
-            start: desc.camera_from_world.start.inverse(),
-            end: desc.camera_from_world.end.inverse(),
+            start: render_from_world * desc.camera_from_world.start.inverse(),
+            end: render_from_world * desc.camera_from_world.end.inverse(),
             ..desc.camera_from_world
         };
         Ok(Self {
@@ -162,7 +167,7 @@ mod tests {
 
     fn camera(text: &str, res: (u32, u32)) -> Camera {
         let d = acr_parser::parse_str(text, Path::new("c.pbrt")).unwrap();
-        Camera::new(d.camera.as_ref().unwrap(), res).unwrap()
+        Camera::new(d.camera.as_ref().unwrap(), res, glam::DMat4::IDENTITY).unwrap()
     }
 
     #[test]

@@ -609,6 +609,7 @@ fn used_materials(desc: &SceneDescription) -> Vec<bool> {
 pub fn build_materials(
     desc: &SceneDescription,
     main_dir: &Path,
+    render_from_world: glam::DMat4,
     warnings: &mut Vec<Warning>,
 ) -> Result<Vec<Material>> {
     for md in &desc.materials {
@@ -621,7 +622,7 @@ pub fn build_materials(
     let n = desc.materials.len();
     let mut b = MaterialBuilder {
         desc,
-        textures: TextureBuilder::new(desc, main_dir),
+        textures: TextureBuilder::new(desc, main_dir).with_render_from_world(render_from_world),
         built: vec![None; n],
         in_progress: vec![false; n],
     };
@@ -670,14 +671,20 @@ mod tests {
         let full = format!("WorldBegin\n{text}\nWorldEnd\n");
         let desc = parse_str(&full, &dir.join("scene.pbrt")).unwrap();
         let mut w = Vec::new();
-        let m = build_materials(&desc, dir, &mut w).unwrap();
+        let m = build_materials(&desc, dir, glam::DMat4::IDENTITY, &mut w).unwrap();
         (m, w)
     }
 
     fn build_err(text: &str) -> Error {
         let full = format!("WorldBegin\n{text}\nWorldEnd\n");
         let desc = parse_str(&full, Path::new("/tmp/scene.pbrt")).unwrap();
-        build_materials(&desc, Path::new("/tmp"), &mut Vec::new()).unwrap_err()
+        build_materials(
+            &desc,
+            Path::new("/tmp"),
+            glam::DMat4::IDENTITY,
+            &mut Vec::new(),
+        )
+        .unwrap_err()
     }
 
     const SHAPE: &str = r#"Shape "sphere""#;
@@ -964,7 +971,7 @@ mod tests {
         let text = text.replace("Material \"plastic\"\n", "");
         let full = format!("WorldBegin\n{text}\nWorldEnd\n");
         let desc = parse_str(&full, &dir.join("scene.pbrt")).unwrap();
-        let e = build_materials(&desc, &dir, &mut Vec::new()).unwrap_err();
+        let e = build_materials(&desc, &dir, glam::DMat4::IDENTITY, &mut Vec::new()).unwrap_err();
         assert!(e.message().contains("missing.png"), "{e}");
         assert!(desc.unused_parameter_warnings().is_empty());
         std::fs::remove_dir_all(&dir).ok();

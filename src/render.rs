@@ -154,10 +154,13 @@ pub fn render(
     if let Some(p) = progress {
         p.set_length(total as u64);
     }
+    // Reused by every batch: a fresh half-megabyte vector per batch costs page faults.
+    let mut results: Vec<(Vec2, Spectrum, u32)> = Vec::new();
+    let mut valid: Vec<(Vec2, Spectrum)> = Vec::new();
     while start < total {
         // Whole pixels per batch, so a pixel's samples stay together.
         let end = (start + BATCH_SAMPLES.div_ceil(spp_us).max(1) * spp_us).min(total);
-        let results: Vec<(Vec2, Spectrum, u32)> = (start..end)
+        (start..end)
             .into_par_iter()
             .map(|k| {
                 let (pixel, index) = (k / spp_us, (k % spp_us) as u32);
@@ -180,9 +183,9 @@ pub fn render(
                 let r = integrator.li(scene, ray, &mut stream);
                 (film_pos, r.l, r.rays)
             })
-            .collect();
-        let mut valid = Vec::with_capacity(results.len());
-        for (pos, l, rays) in results {
+            .collect_into_vec(&mut results);
+        valid.clear();
+        for &(pos, l, rays) in &results {
             counts.rays += rays as u64;
             if is_valid_radiance(l) {
                 valid.push((pos, l));

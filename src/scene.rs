@@ -79,6 +79,11 @@ pub struct Scene {
     pub world_center: Vec3,
     /// Radius of the scene's bounding sphere.
     pub world_radius: f32,
+    /// Render space from world space: everything the scene holds (geometry, lights, camera,
+    /// textures) is in render space, the world translated so that the camera sits at the
+    /// origin (pbrt-v4's "camera-world" space). f32 resolution is finest near the origin, so a
+    /// scene far from the world origin renders as precisely as one at it.
+    pub render_from_world: DMat4,
 }
 
 /// A ray's closest hit, resolved.
@@ -408,6 +413,21 @@ impl Builder<'_> {
     }
 }
 
+/// The translation that takes the camera's position (at its start transform) to the origin.
+/// Exact in f64; a camera description that cannot be inverted gives the identity.
+fn render_from_world(camera: &acr_parser::CameraDesc) -> DMat4 {
+    let camera_pos = camera
+        .camera_from_world
+        .start
+        .inverse()
+        .transform_point3(glam::DVec3::ZERO);
+    if camera_pos.is_finite() {
+        DMat4::from_translation(-camera_pos)
+    } else {
+        DMat4::IDENTITY
+    }
+}
+
 /// An RGB-valued parameter (rgb, spectrum or blackbody) or its default.
 pub fn rgb_param(params: &ParamList, name: &str, default: Spectrum) -> Result<Spectrum> {
     Ok(crate::texture::spectrum_value(params, name)?.unwrap_or(default))
@@ -444,7 +464,13 @@ impl Scene {
             return Err(Error::file(path, "the scene has no Camera"));
         };
         let film = FilmSettings::new(desc.film.as_ref())?;
-        let camera = Camera::new(camera_desc, film.resolution)?;
+        let render_from_world = render_from_world(camera_desc);
+        let in_render = |t: &acr_parser::AnimatedTransform| acr_parser::AnimatedTransform {
+            start: render_from_world * t.start,
+            end: render_from_world * t.end,
+            ..*t
+        };
+        let camera = Camera::new(camera_desc, film.resolution, render_from_world)?;
         let mut b = Builder {
             desc,
             warnings,
@@ -473,12 +499,13 @@ impl Scene {
                 accel.objects.push(g);
                 accel.instances.push(Instance {
                     object: (accel.objects.len() - 1) as u32,
-                    placement: Placement::Moving(Box::new(MotionTransform::new(
+                    placement: Placement::Moving(Box::new(MotionTransform::new(&in_render(
                         &shape.world_from_object,
-                    ))),
+                    )))),
                 });
             } else {
-                b.add_shape(&mut world, shape, &shape.world_from_object.start, true)?;
+                let m = render_from_world * shape.world_from_object.start;
+                b.add_shape(&mut world, shape, &m, true)?;
             }
         }
         let first_object = accel.objects.len() as u32;
@@ -499,7 +526,7 @@ impl Scene {
             accel.objects.push(g);
         }
         for inst in &desc.instances {
-            let t = &inst.world_from_instance;
+            let t = &in_render(&inst.world_from_instance);
             let placement = if t.is_animated() && t.end_time > t.start_time {
                 Placement::Moving(Box::new(MotionTransform::new(t)))
             } else {
@@ -550,11 +577,17 @@ impl Scene {
             }
         }
         for l in &desc.lights {
-            if let Some(light) = b.light(&l.plugin, &l.world_from_light, world_radius, &main_dir)? {
+            if let Some(light) = b.light(
+                &l.plugin,
+                &(render_from_world * l.world_from_light),
+                world_radius,
+                &main_dir,
+            )? {
                 b.lights.push(light);
             }
         }
-        let materials = crate::material::build_materials(desc, &main_dir, b.warnings)?;
+        let materials =
+            crate::material::build_materials(desc, &main_dir, render_from_world, b.warnings)?;
         let powers: Vec<f32> = b
             .lights
             .iter()
@@ -589,6 +622,7 @@ impl Scene {
             dims,
             world_center,
             world_radius,
+            render_from_world,
         })
     }
 }

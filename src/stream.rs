@@ -55,6 +55,9 @@ impl Pcg32 {
     }
 }
 
+/// Samples per pixel that the Sobol sequence covers (sobol_burley's limit).
+const SOBOL_SAMPLES: u32 = 1 << 16;
+
 /// The random numbers of one sample.
 #[derive(Clone, Debug)]
 pub struct SampleStream {
@@ -92,7 +95,8 @@ impl SampleStream {
     pub fn next_1d(&mut self) -> f32 {
         let d = self.dim;
         self.dim += 1;
-        if d < sobol_burley::NUM_DIMENSIONS {
+        // sobol_burley's sequences hold 2^16 samples: a pixel's later samples are random.
+        if d < sobol_burley::NUM_DIMENSIONS && self.index < SOBOL_SAMPLES {
             let set = d / 4;
             if set != self.block_set {
                 self.block = sobol_burley::sample_4d(self.index, set, self.scramble);
@@ -129,6 +133,9 @@ mod tests {
         for dim in 5..40 {
             assert_eq!(d.next_1d(), sobol_burley::sample(3, dim, d.scramble));
         }
+        // Past the Sobol sequence's 2^16 samples, values are still in range.
+        let mut late = SampleStream::new(17, 1 << 17, 42, 0);
+        assert!((0..300).all(|_| (0.0..1.0).contains(&late.next_1d())));
         let mut c = SampleStream::new(18, 3, 42, 5);
         assert_ne!(SampleStream::new(17, 3, 42, 5).next_1d(), c.next_1d());
     }

@@ -547,6 +547,8 @@ pub struct TextureBuilder<'a> {
     spectrum_maps: HashMap<ImageKey, Arc<ImageMap<Spectrum>>>,
     warned: HashSet<String>,
     warnings: Vec<Warning>,
+    /// Render space from world space (see [`crate::scene::Scene::render_from_world`]).
+    render_from_world: DMat4,
 }
 
 /// Per-value-type access to the builder's caches and parameter lookups.
@@ -613,7 +615,15 @@ impl<'a> TextureBuilder<'a> {
             spectrum_maps: HashMap::new(),
             warned: HashSet::new(),
             warnings: Vec::new(),
+            render_from_world: DMat4::IDENTITY,
         }
+    }
+
+    /// Places textures in render space (a 3D texture or a planar mapping keeps its world
+    /// position on the surface).
+    pub fn with_render_from_world(mut self, m: DMat4) -> Self {
+        self.render_from_world = m;
+        self
     }
 
     /// The main scene file's directory.
@@ -794,7 +804,11 @@ impl<'a> TextureBuilder<'a> {
                 let tex2 = self.param_or(p, "tex2", T::ZERO)?;
                 match p.int_or("dimension", 2)? {
                     2 => {
-                        let mapping = Mapping2D::from_params(p, &td.world_from_texture, loc)?;
+                        let mapping = Mapping2D::from_params(
+                            p,
+                            &(self.render_from_world * td.world_from_texture),
+                            loc,
+                        )?;
                         match p.string("aamode")? {
                             None | Some("none") | Some("closedform") => {}
                             Some(other) => {
@@ -816,7 +830,7 @@ impl<'a> TextureBuilder<'a> {
                         }
                     }
                     3 => {
-                        let inv = td.world_from_texture.inverse();
+                        let inv = (self.render_from_world * td.world_from_texture).inverse();
                         Texture::Checkerboard3D {
                             texture_from_world: if inv.is_finite() {
                                 inv.as_mat4()
@@ -839,12 +853,20 @@ impl<'a> TextureBuilder<'a> {
                 }
             }
             "imagemap" => {
-                let mapping = Mapping2D::from_params(p, &td.world_from_texture, loc)?;
+                let mapping = Mapping2D::from_params(
+                    p,
+                    &(self.render_from_world * td.world_from_texture),
+                    loc,
+                )?;
                 let image = self.image_map::<T>(p, loc)?;
                 Texture::Image { mapping, image }
             }
             "bilerp" => {
-                let mapping = Mapping2D::from_params(p, &td.world_from_texture, loc)?;
+                let mapping = Mapping2D::from_params(
+                    p,
+                    &(self.render_from_world * td.world_from_texture),
+                    loc,
+                )?;
                 let mut v = [T::ZERO, T::ONE, T::ZERO, T::ONE];
                 for (slot, name) in v.iter_mut().zip(["v00", "v01", "v10", "v11"]) {
                     if let Some(c) = T::param(self, p, name)?.and_then(|t| t.as_constant()) {
@@ -854,7 +876,11 @@ impl<'a> TextureBuilder<'a> {
                 Texture::Bilerp { mapping, v }
             }
             "uv" if T::kind() == TextureValue::Spectrum => Texture::Uv {
-                mapping: Mapping2D::from_params(p, &td.world_from_texture, loc)?,
+                mapping: Mapping2D::from_params(
+                    p,
+                    &(self.render_from_world * td.world_from_texture),
+                    loc,
+                )?,
             },
             "uv" => {
                 return Err(Error::at(

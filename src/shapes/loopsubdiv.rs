@@ -917,9 +917,10 @@ mod tests {
         }
     }
 
+    /// A scene with the camera at the world origin: render space is then world space.
     fn scene(shape: &str) -> acr_parser::SceneDescription {
         let text = format!(
-            "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n{shape}\nWorldEnd\n"
+            "LookAt 0 0 0  0 0 -1  0 1 0\nCamera \"perspective\"\nWorldBegin\n{shape}\nWorldEnd\n"
         );
         acr_parser::parse_str(&text, Path::new("/tmp/loop.pbrt")).unwrap()
     }

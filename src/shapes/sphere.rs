@@ -41,7 +41,7 @@ pub struct Sphere {
 pub struct SphereHit {
     /// Object-space hit point, re-projected onto the sphere.
     pub p: Vec3,
-    /// Its azimuth in [0, 2 pi).
+    /// Its azimuth in [0, 2 pi), or -1 where not computed yet (full spheres).
     pub phi: f32,
 }
 
@@ -102,7 +102,10 @@ impl Sphere {
         if p.x == 0.0 && p.y == 0.0 {
             p.x = 1e-5 * self.radius;
         }
-        (p, phi_of(p))
+        // Only a partial sphere needs phi to clip; a full one computes it in `interaction`,
+        // for the one hit that is kept (atan2 per candidate hit is measurable).
+        let phi = if self.is_full() { -1.0 } else { phi_of(p) };
+        (p, phi)
     }
 
     /// Whether the partial-shape cuts remove the point.
@@ -169,7 +172,8 @@ impl Sphere {
     /// ReverseOrientation xor handedness swap, then carried to world space.
     pub fn interaction(&self, ray: &Ray, _t: f32, hit: &SphereHit) -> SurfaceInteraction {
         let p = hit.p;
-        let u = hit.phi / self.phi_max;
+        let phi = if hit.phi < 0.0 { phi_of(p) } else { hit.phi };
+        let u = phi / self.phi_max;
         let theta = (p.z / self.radius).clamp(-1.0, 1.0).acos();
         let dtheta = self.theta_max - self.theta_min;
         let v = (theta - self.theta_min) / dtheta;

@@ -1,0 +1,625 @@
+//! The `acr` command line, run as a process: `acr render` (outputs, stats file, determinism,
+//! errors) and `acr diff`, as ARCHITECTURE.md specifies them.
+
+use acr::image_io::read_image;
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh folder under the system's temporary folder, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        static COUNTER: AtomicUsize = AtomicUsize::new(0);
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let dir = std::env::temp_dir().join(format!(
+            "acr-cli-{name}-{}-{nanos}-{}",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+
+    fn join(&self, p: impl AsRef<Path>) -> PathBuf {
+        self.0.join(p)
+    }
+
+    /// Writes `text` to `name` in this folder and gives its path.
+    fn write(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.join(name);
+        if let Some(d) = p.parent() {
+            std::fs::create_dir_all(d).unwrap();
+        }
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn acr_command<I, S>(args: I) -> Command
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<OsStr>,
+{
+    let mut c = Command::new(env!("CARGO_BIN_EXE_acr"));
+    c.args(args);
+    c
+}
+
+/// Runs `acr` with `args` and gives what it printed.
+fn acr<I, S>(args: I) -> Output
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<OsStr>,
+{
+    acr_command(args).output().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Asserts a clean failure: exit status non-zero, a message, no panic.
+fn assert_clean_failure(o: &Output, what: &str) {
+    let err = stderr(o);
+    assert!(!o.status.success(), "{what}: succeeded; stderr: {err}");
+    assert!(o.status.code().is_some(), "{what}: killed by a signal");
+    assert!(!err.contains("panicked"), "{what}: {err}");
+    assert!(!err.trim().is_empty(), "{what}: no message");
+}
+
+/// A small scene: a matte sphere on a floor under a point light and a dim sky, path traced.
+/// 24 x 16 (not square, so that swapped sizes show).
+fn small_scene(extra_film: &str) -> String {
+    format!(
+        "LookAt 0 1 -4  0 0.5 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n\
+         Film \"image\" \"integer xresolution\" 24 \"integer yresolution\" 16 {extra_film}\n\
+         Integrator \"path\" \"integer maxdepth\" 3\nWorldBegin\n\
+         LightSource \"point\" \"point3 from\" [1 3 -2] \"rgb I\" [10 10 10]\n\
+         LightSource \"infinite\" \"rgb L\" [0.2 0.2 0.2]\n\
+         Material \"matte\" \"rgb Kd\" [0.5 0.5 0.5]\n\
+         AttributeBegin\nTranslate 0 0.5 0\nShape \"sphere\" \"float radius\" 0.5\nAttributeEnd\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
+         \"point3 P\" [-3 0 -3  -3 0 3  3 0 3  3 0 -3]\nWorldEnd\n"
+    )
+}
+
+/// The text of scenes/NAME with the Film's resolution replaced by `w` x `h`.
+fn example_scene(name: &str, w: u32, h: u32) -> String {
+    let mut text = std::fs::read_to_string(root().join("scenes").join(name)).unwrap();
+    for (key, value) in [("xresolution", w), ("yresolution", h)] {
+        let pat = format!("\"integer {key}\" [");
+        let start = text
+            .find(&pat)
+            .unwrap_or_else(|| panic!("{name}: no {key}"))
+            + pat.len();
+        let end = start + text[start..].find(']').unwrap();
+        text.replace_range(start..end, &value.to_string());
+    }
+    text
+}
+
+fn read_stats(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}\n{text}", path.display()))
+}
+
+fn dims(stats: &serde_json::Value) -> Vec<String> {
+    stats["dims"]
+        .as_array()
+        .unwrap_or_else(|| panic!("dims: {}", stats["dims"]))
+        .iter()
+        .map(|d| d.as_str().unwrap().to_owned())
+        .collect()
+}
+
+/// Renders `scene` with `args` after the output and checks the run succeeded.
+fn render_ok(scene: &Path, output: &Path, args: &[&str]) -> Output {
+    let mut all: Vec<&OsStr> = vec![
+        "render".as_ref(),
+        scene.as_os_str(),
+        "-o".as_ref(),
+        output.as_os_str(),
+        "--quiet".as_ref(),
+    ];
+    all.extend(args.iter().map(OsStr::new));
+    let o = acr(&all);
+    assert!(o.status.success(), "acr {all:?}: {}", stderr(&o));
+    o
+}
+
+#[test]
+fn render_writes_a_png_of_the_film_size_and_every_stats_key() {
+    let dir = TempDir::new("png-stats");
+    let scene = dir.write("small.pbrt", &small_scene(""));
+    let (png, stats_path) = (dir.join("out.png"), dir.join("s.json"));
+    let o = render_ok(
+        &scene,
+        &png,
+        &[
+            "--spp",
+            "2",
+            "--seed",
+            "9",
+            "--stats",
+            stats_path.to_str().unwrap(),
+        ],
+    );
+    // --quiet: no summary line (and no progress bar in a pipe).
+    assert!(stderr(&o).trim().is_empty(), "{}", stderr(&o));
+
+    assert_eq!(image::image_dimensions(&png).unwrap(), (24, 16));
+    let img = read_image(&png, true).unwrap();
+    assert!(
+        img.pixels.iter().any(|p| p.max_element() > 0.0),
+        "black image"
+    );
+
+    let s = read_stats(&stats_path);
+    let keys = [
+        "scene",
+        "width",
+        "height",
+        "spp",
+        "samples",
+        "rays",
+        "threads",
+        "seed",
+        "sampler",
+        "filter",
+        "integrator",
+        "dims",
+        "clusters",
+        "dropped_samples",
+        "seconds",
+        "mrays_per_s",
+        "peak_rss_mb",
+    ];
+    let obj = s.as_object().unwrap();
+    for k in keys {
+        assert!(obj.contains_key(k), "stats lack \"{k}\": {s}");
+    }
+    assert_eq!(s["scene"].as_str(), scene.to_str());
+    let n = |k: &str| {
+        s[k].as_u64()
+            .unwrap_or_else(|| panic!("{k} is not a whole number: {}", s[k]))
+    };
+    let (w, h, spp) = (n("width"), n("height"), n("spp"));
+    assert_eq!((w, h, spp), (24, 16, 2));
+    assert_eq!(n("samples"), w * h * spp);
+    assert!(n("rays") >= n("samples"), "{s}");
+    assert!(n("threads") >= 1);
+    assert_eq!(n("seed"), 9);
+    assert_eq!(n("dropped_samples"), 0);
+    for k in ["sampler", "filter", "integrator"] {
+        assert!(
+            s[k].as_str().is_some_and(|v| !v.is_empty()),
+            "{k}: {}",
+            s[k]
+        );
+    }
+    assert_eq!(s["integrator"], "path");
+    assert_eq!(dims(&s), ["x", "y"]);
+    // Only the cluster sampler has clusters; a number otherwise would be made up.
+    assert!(
+        s["clusters"].is_null() || s["sampler"] == "cluster",
+        "{}",
+        s["clusters"]
+    );
+    let secs = s["seconds"].as_object().unwrap();
+    let mut sum = 0.0;
+    for k in ["parse", "build", "render", "reconstruct", "write", "total"] {
+        let v = secs
+            .get(k)
+            .and_then(|v| v.as_f64())
+            .unwrap_or_else(|| panic!("seconds.{k} missing: {}", s["seconds"]));
+        assert!(v.is_finite() && v >= 0.0, "seconds.{k} = {v}");
+        if k != "total" {
+            sum += v;
+        }
+    }
+    assert!(
+        secs["total"].as_f64().unwrap() >= sum * 0.999,
+        "total is less than its parts: {}",
+        s["seconds"]
+    );
+    let mrays = s["mrays_per_s"].as_f64().unwrap();
+    assert!(mrays.is_finite() && mrays >= 0.0, "{mrays}");
+    let rss = s["peak_rss_mb"].as_f64().unwrap();
+    assert!(rss.is_finite() && rss >= 0.0, "{rss}");
+    if cfg!(target_os = "linux") {
+        assert!(rss > 1.0, "peak RSS {rss} MiB");
+    }
+}
+
+/// The rendering space's dimensions follow the scene: x y for a static pinhole scene, t with
+/// motion, u v with a lens; width, height and samples follow the Film.
+#[test]
+fn stats_dims_follow_the_scene() {
+    let dir = TempDir::new("dims");
+    let cases: [(&str, &[&str]); 4] = [
+        ("cornell-box.pbrt", &["x", "y"]),
+        ("motion-blur.pbrt", &["x", "y", "t"]),
+        ("depth-of-field.pbrt", &["x", "y", "u", "v"]),
+        ("motion-dof.pbrt", &["x", "y", "t", "u", "v"]),
+    ];
+    for (i, (name, expected)) in cases.into_iter().enumerate() {
+        let (w, h) = (20 + 2 * i as u32, 14 + i as u32);
+        let scene = dir.write(name, &example_scene(name, w, h));
+        let stats_path = dir.join(format!("{name}.json"));
+        let out = dir.join(format!("{name}.exr"));
+        render_ok(
+            &scene,
+            &out,
+            &["--spp", "1", "--stats", stats_path.to_str().unwrap()],
+        );
+        let s = read_stats(&stats_path);
+        assert_eq!(dims(&s), expected, "{name}");
+        assert_eq!(s["width"].as_u64(), Some(w as u64), "{name}");
+        assert_eq!(s["height"].as_u64(), Some(h as u64), "{name}");
+        assert_eq!(s["spp"].as_u64(), Some(1), "{name}");
+        assert_eq!(s["samples"].as_u64(), Some((w * h) as u64), "{name}");
+        let img = read_image(&out, false).unwrap();
+        assert_eq!((img.width, img.height), (w as usize, h as usize), "{name}");
+    }
+}
+
+#[test]
+fn exr_and_pfm_outputs_read_back_with_the_film_size() {
+    let dir = TempDir::new("formats");
+    let scene = dir.write("small.pbrt", &small_scene(""));
+    let mut images = Vec::new();
+    for ext in ["exr", "pfm", "png"] {
+        let out = dir.join(format!("out.{ext}"));
+        render_ok(&scene, &out, &["--spp", "2", "--seed", "3"]);
+        let img = read_image(&out, false).unwrap_or_else(|e| panic!("{ext}: {e}"));
+        assert_eq!((img.width, img.height), (24, 16), "{ext}");
+        assert_eq!(img.pixels.len(), 24 * 16, "{ext}");
+        images.push(img);
+    }
+    let (exr, pfm, png) = (&images[0], &images[1], &images[2]);
+    assert!(exr.pixels.iter().any(|p| p.max_element() > 0.0));
+    // Both hold 32-bit floats, top row first: the same seed gives the same pixels.
+    assert_eq!(exr, pfm, "EXR and PFM of the same render differ");
+    // The PNG holds the same image in 8-bit sRGB.
+    for (i, (f, q)) in exr.pixels.iter().zip(&png.pixels).enumerate() {
+        for c in 0..3 {
+            let expected = acr::image_io::to_srgb8(f[c]) as f32 / 255.0;
+            assert!(
+                (q[c] - expected).abs() < 1e-6,
+                "pixel {i} channel {c}: PNG {} vs EXR {} ({expected})",
+                q[c],
+                f[c]
+            );
+        }
+    }
+}
+
+/// Runs `cmd` and kills it if it has not finished within `limit`.
+fn output_within(mut cmd: Command, limit: Duration) -> Output {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let o = child.wait_with_output().unwrap();
+            panic!("still running after {limit:?} (rendering?): {}", stderr(&o));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// A scene that takes minutes to render (2000 x 2000 at 256 spp): a command that fails within
+/// seconds on it failed before rendering.
+fn slow_scene(dir: &TempDir) -> PathBuf {
+    let text = small_scene("").replace(
+        "\"integer xresolution\" 24 \"integer yresolution\" 16",
+        "\"integer xresolution\" 2000 \"integer yresolution\" 2000",
+    );
+    assert!(text.contains("2000"));
+    dir.write("slow.pbrt", &text)
+}
+
+#[test]
+fn an_unknown_output_format_fails_before_rendering() {
+    let dir = TempDir::new("jpg");
+    let scene = slow_scene(&dir);
+    let out = dir.join("out.jpg");
+    let o = output_within(
+        acr_command([
+            "render".as_ref(),
+            scene.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+            "--spp".as_ref(),
+            "256".as_ref(),
+        ]),
+        Duration::from_secs(20),
+    );
+    assert_clean_failure(&o, "-o out.jpg");
+    let err = stderr(&o);
+    assert!(err.contains("jpg"), "the message names the format: {err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_missing_output_folder_fails_cleanly_before_rendering() {
+    let dir = TempDir::new("nofolder");
+    let scene = slow_scene(&dir);
+    let out = dir.join("missing/deeper/out.png");
+    let o = output_within(
+        acr_command([
+            "render".as_ref(),
+            scene.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+            "--spp".as_ref(),
+            "256".as_ref(),
+        ]),
+        Duration::from_secs(20),
+    );
+    assert_clean_failure(&o, "-o missing/deeper/out.png");
+    let err = stderr(&o);
+    assert!(
+        err.contains("missing"),
+        "the message names the folder: {err}"
+    );
+    assert!(
+        !dir.join("missing").exists(),
+        "the folder was created behind the user's back"
+    );
+}
+
+#[test]
+fn the_same_seed_gives_the_same_file_whatever_the_thread_count() {
+    let dir = TempDir::new("threads");
+    let scene = dir.write("motion-dof.pbrt", &example_scene("motion-dof.pbrt", 40, 30));
+    let run = |threads: &str, seed: &str, name: &str| {
+        let (out, stats) = (dir.join(name), dir.join(format!("{name}.json")));
+        render_ok(
+            &scene,
+            &out,
+            &[
+                "--spp",
+                "4",
+                "--threads",
+                threads,
+                "--seed",
+                seed,
+                "--stats",
+                stats.to_str().unwrap(),
+            ],
+        );
+        assert_eq!(
+            read_stats(&stats)["threads"].as_u64(),
+            Some(threads.parse().unwrap()),
+            "threads in the stats"
+        );
+        std::fs::read(&out).unwrap()
+    };
+    let one = run("1", "5", "one.exr");
+    let two = run("2", "5", "two.exr");
+    assert!(
+        one == two,
+        "--threads 1 and 2 with --seed 5 give different files"
+    );
+    let other = run("2", "6", "other.exr");
+    assert!(one != other, "--seed 6 gives the same file as --seed 5");
+}
+
+/// Scenes with an error at a known place: (text, line, column, a word of the message).
+const BAD_SCENES: &[(&str, u32, u32, &str)] = &[
+    // An unknown directive, indented.
+    (
+        "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n  Shpae \"sphere\"\nWorldEnd\n",
+        4,
+        3,
+        "Shpae",
+    ),
+    // A parameter of the wrong type: the message points at the parameter.
+    (
+        "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\n\
+         Shape \"sphere\" \"float radius\" \"one\"\nWorldEnd\n",
+        5,
+        16,
+        "radius",
+    ),
+    // A bracket left open: the first token that cannot be a value is the error.
+    (
+        "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+         Shape \"sphere\" \"float radius\" [ 1\nWorldEnd\n",
+        5,
+        1,
+        "WorldEnd",
+    ),
+    // Found when the scene is built, not parsed: an unknown light.
+    (
+        "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nShape \"sphere\"\n\
+         LightSource \"pointt\"\nWorldEnd\n",
+        5,
+        1,
+        "pointt",
+    ),
+];
+
+#[test]
+fn scene_errors_are_located_and_never_panic() {
+    let dir = TempDir::new("errors");
+    for (i, &(text, line, col, word)) in BAD_SCENES.iter().enumerate() {
+        let scene = dir.write(&format!("bad{i}.pbrt"), text);
+        let out = dir.join(format!("bad{i}.png"));
+        let o = acr([
+            "render".as_ref(),
+            scene.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+            "--quiet".as_ref(),
+        ]);
+        assert_clean_failure(&o, &format!("bad scene {i}"));
+        let err = stderr(&o);
+        let prefix = format!("{}:{line}:{col}: ", scene.display());
+        assert!(
+            err.starts_with(&prefix),
+            "bad scene {i}: expected {prefix:?} first, got:\n{err}"
+        );
+        assert!(err.contains(word), "bad scene {i}: {err}");
+        assert!(!out.exists(), "bad scene {i}: an image was written");
+    }
+}
+
+/// The number after `name ` in `acr diff`'s text output.
+fn text_field(text: &str, name: &str) -> f64 {
+    let mut words = text.split_whitespace();
+    words
+        .by_ref()
+        .find(|w| *w == name)
+        .unwrap_or_else(|| panic!("no {name} in {text:?}"));
+    let v = words.next().unwrap();
+    v.parse()
+        .unwrap_or_else(|_| panic!("{name} is {v:?} in {text:?}"))
+}
+
+#[test]
+fn diff_measures_the_error_between_two_images() {
+    let dir = TempDir::new("diff");
+    let scene = dir.write("small.pbrt", &small_scene(""));
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    render_ok(&scene, &a, &["--spp", "2", "--seed", "1"]);
+    render_ok(&scene, &b, &["--spp", "2", "--seed", "2"]);
+
+    // An image against itself.
+    let o = acr([OsStr::new("diff"), a.as_os_str(), a.as_os_str()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(text_field(&stdout(&o), "mse"), 0.0, "{}", stdout(&o));
+    assert_eq!(text_field(&stdout(&o), "relmse"), 0.0, "{}", stdout(&o));
+    let o = acr([
+        OsStr::new("diff"),
+        a.as_os_str(),
+        a.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    for k in ["mse", "relmse", "psnr"] {
+        assert!(v.get(k).is_some(), "--json lacks {k}: {v}");
+    }
+    assert_eq!(v["mse"].as_f64(), Some(0.0));
+    assert_eq!(v["relmse"].as_f64(), Some(0.0));
+
+    // Two renders with different seeds, against this test's own reckoning (ALGORITHM.md 7).
+    let o = acr([
+        OsStr::new("diff"),
+        a.as_os_str(),
+        b.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let (ia, ib) = (
+        read_image(&a, false).unwrap(),
+        read_image(&b, false).unwrap(),
+    );
+    let n = (3 * ia.pixels.len()) as f64;
+    let (mut se, mut rel, mut clamped) = (0.0, 0.0, 0.0);
+    for (x, r) in ia.pixels.iter().zip(&ib.pixels) {
+        for c in 0..3 {
+            let (x, r) = (x[c] as f64, r[c] as f64);
+            se += (x - r).powi(2);
+            rel += (x - r).powi(2) / (r * r + 0.01);
+            clamped += (x.clamp(0.0, 1.0) - r.clamp(0.0, 1.0)).powi(2);
+        }
+    }
+    let (mse, relmse, psnr) = (se / n, rel / n, 10.0 * (n / clamped).log10());
+    assert!(mse > 0.0);
+    let near = |k: &str, want: f64| {
+        let got = v[k]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{k} is not a number: {v}"));
+        assert!(
+            (got - want).abs() <= 1e-9 * want.abs(),
+            "{k}: acr diff says {got}, expected {want}"
+        );
+    };
+    near("mse", mse);
+    near("relmse", relmse);
+    near("psnr", psnr);
+    // The text output agrees (it prints 7 significant digits).
+    let o = acr([OsStr::new("diff"), a.as_os_str(), b.as_os_str()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text_mse = text_field(&stdout(&o), "mse");
+    assert!((text_mse - mse).abs() <= 1e-6 * mse, "{text_mse} vs {mse}");
+
+    // Images of different sizes cannot be compared.
+    let small = dir.write(
+        "smaller.pbrt",
+        &small_scene("").replace("yresolution\" 16", "yresolution\" 12"),
+    );
+    let c = dir.join("c.exr");
+    render_ok(&small, &c, &["--spp", "1"]);
+    assert_eq!(read_image(&c, false).unwrap().height, 12);
+    let o = acr([OsStr::new("diff"), a.as_os_str(), c.as_os_str()]);
+    assert_clean_failure(&o, "diff of 24x16 and 24x12");
+    let err = stderr(&o);
+    assert!(
+        err.contains("24x16") && err.contains("24x12"),
+        "the message gives both sizes: {err}"
+    );
+    assert!(stdout(&o).trim().is_empty(), "{}", stdout(&o));
+}
+
+/// Without -o the Film's "filename" is used, relative to the working directory (as pbrt-v3
+/// does), not to the scene's folder; without either, the scene's path with .exr.
+#[test]
+fn without_an_output_the_films_filename_is_used() {
+    let dir = TempDir::new("filmname");
+    dir.write(
+        "sub/named.pbrt",
+        &small_scene("\"string filename\" \"film-name.png\""),
+    );
+    dir.write("sub/unnamed.pbrt", &small_scene(""));
+    let run = |scene: &str| {
+        let o = acr_command(["render", scene, "--spp", "1", "--quiet"])
+            .current_dir(&dir.0)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{scene}: {}", stderr(&o));
+    };
+    run("sub/named.pbrt");
+    let written = dir.join("film-name.png");
+    assert!(
+        written.is_file(),
+        "film-name.png is not in the working directory"
+    );
+    assert!(!dir.join("sub/film-name.png").exists());
+    assert_eq!(image::image_dimensions(&written).unwrap(), (24, 16));
+
+    run("sub/unnamed.pbrt");
+    let exr = dir.join("sub/unnamed.exr");
+    assert!(exr.is_file(), "no sub/unnamed.exr");
+    let img = read_image(&exr, false).unwrap();
+    assert_eq!((img.width, img.height), (24, 16));
+}
