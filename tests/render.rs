@@ -419,3 +419,30 @@ fn instances_render_like_their_shapes_written_out() {
         "{ma} vs {mb}"
     );
 }
+
+/// No bias: a converged render is closer to pbrt-v3's reference than pbrt-v3's own 8-spp render
+/// was. At 32 spp acr's MSE (8-bit sRGB) is what remains of the reference's own noise plus a
+/// quarter of acr's 8-spp noise; a bias of a few percent in any region would stay above it.
+#[test]
+fn converged_render_is_closer_to_pbrt_v3_than_its_own_8_spp() {
+    let dir = root().join("../shared/scenes/pbrt-v3");
+    if !dir.is_dir() {
+        eprintln!("skipped: {} is absent", dir.display());
+        return;
+    }
+    let (scene, reference, pbrt_mse_8spp) = (
+        "spheres-motion/spheres-motion.pbrt",
+        "spheres-motion-ref64.exr",
+        6.0e-4,
+    );
+    let desc = parse_file(&dir.join(scene)).unwrap();
+    let r = render_desc(&desc, 32, 13);
+    let reference =
+        acr::image_io::read_image(&dir.join("references").join(reference), false).unwrap();
+    let mse = srgb8_mse(&r.pixels, &reference.pixels);
+    eprintln!("{scene} at 32 spp: MSE {mse:.3e} (pbrt-v3 at 8 spp: {pbrt_mse_8spp:.1e})");
+    assert!(
+        mse < 0.5 * pbrt_mse_8spp,
+        "{scene}: MSE {mse:.3e} at 32 spp is not below half of pbrt-v3's {pbrt_mse_8spp:.1e} at 8 spp"
+    );
+}
