@@ -56,9 +56,9 @@ fn extension(path: &Path) -> String {
 /// conversion, and its environment maps use PNG values as they are).
 pub fn read_image(path: &Path, srgb: bool) -> Result<RgbImage, String> {
     let img = match extension(path).as_str() {
-        "png" => read_png(path)?,
+        "png" => read_with_image_crate(path)?,
         "exr" => read_exr(path)?,
-        "hdr" => read_hdr(path)?,
+        "hdr" => read_with_image_crate(path)?,
         "pfm" => read_pfm(path)?,
         other => {
             return Err(format!(
@@ -85,28 +85,9 @@ pub fn linearize(mut img: RgbImage) -> RgbImage {
     img
 }
 
-fn read_png(path: &Path) -> Result<RgbImage, String> {
-    let img = image::ImageReader::open(path)
-        .map_err(|e| e.to_string())?
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?
-        .decode()
-        .map_err(|e| e.to_string())?;
-    // Integer samples become [0, 1] floats (v / 255 or v / 65535); grey becomes RGB.
-    let rgb = img.to_rgb32f();
-    let (width, height) = (rgb.width() as usize, rgb.height() as usize);
-    let pixels = rgb
-        .pixels()
-        .map(|p| Spectrum::new(p[0], p[1], p[2]))
-        .collect();
-    Ok(RgbImage {
-        width,
-        height,
-        pixels,
-    })
-}
-
-fn read_hdr(path: &Path) -> Result<RgbImage, String> {
+/// PNG and Radiance HDR through the `image` crate: integer samples become [0, 1] floats
+/// (v / 255 or v / 65535), HDR values stay as they are, grey becomes RGB.
+fn read_with_image_crate(path: &Path) -> Result<RgbImage, String> {
     let img = image::ImageReader::open(path)
         .map_err(|e| e.to_string())?
         .with_guessed_format()
