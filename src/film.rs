@@ -101,6 +101,29 @@ pub struct Film {
     settings: FilmSettings,
     splat: Splat,
     sums: Vec<[f64; 4]>,
+    /// [`Film::add_samples`]'s prepared samples, kept to reuse the allocation.
+    prepared: Vec<Prepared>,
+}
+
+/// Film columns a [`Prepared`] sample can reach: enough for filters of radius up to 3.5
+/// pixels (wider ones splat through [`Splat::row`]).
+const MAX_SPAN: usize = 8;
+
+/// A sample ready to splat: what does not depend on the film row (the clamped radiance, the
+/// columns reached and their filter-table columns), computed once for the several rows a
+/// sample reaches.
+#[derive(Clone, Copy, Debug)]
+struct Prepared {
+    /// Raster position.
+    p: Vec2,
+    /// Radiance after the luminance clamp.
+    l: Spectrum,
+    /// First film column reached (within the crop).
+    x0: i64,
+    /// Number of columns reached.
+    n: u8,
+    /// Filter-table column of each column reached.
+    fx: [u8; MAX_SPAN],
 }
 
 /// How one sample spreads over a film row: the kernel tabulated over one quadrant of its
@@ -143,6 +166,61 @@ impl Splat {
         }
     }
 
+    /// Whether to splat through [`Prepared`] samples: when a sample reaches several rows (so
+    /// that preparing it pays) and every sample's columns fit one.
+    fn prepare_pays(&self) -> bool {
+        self.radius.1 > 0.5 && 2.0 * self.radius.0 + 1.0 <= MAX_SPAN as f32
+    }
+
+    /// The row-independent part of [`Splat::row`] for the sample at `p` (the same values);
+    /// the filter must fit ([`Splat::prepare_pays`]).
+    #[inline]
+    fn prepare(&self, p: Vec2, l: Spectrum) -> Prepared {
+        let rx = self.radius.0;
+        let (cx0, cx1) = self.columns;
+        let dx = p.x - 0.5;
+        let x0 = ((dx - rx).ceil() as i64).max(cx0);
+        let x1 = ((dx + rx).floor() as i64 + 1).min(cx1);
+        let mut fx = [0u8; MAX_SPAN];
+        let mut n = 0u8;
+        for (slot, x) in fx.iter_mut().zip(x0..x1) {
+            let f = ((x as f32 - dx).abs() / rx * TABLE_SIZE as f32) as usize;
+            *slot = f.min(TABLE_SIZE - 1) as u8;
+            n += 1;
+        }
+        Prepared {
+            p,
+            l: self.clamped(l),
+            x0,
+            n,
+            fx,
+        }
+    }
+
+    /// [`Splat::row`] for a prepared sample: the same contributions, in the same order.
+    #[inline]
+    fn row_prepared(&self, row: &mut [[f64; 4]], y: i64, s: &Prepared) {
+        let ry = self.radius.1;
+        let ay = (y as f32 - (s.p.y - 0.5)).abs();
+        if ay > ry || s.n == 0 {
+            return;
+        }
+        let fy = ((ay / ry * TABLE_SIZE as f32) as usize).min(TABLE_SIZE - 1);
+        let table_row = &self.table[fy * TABLE_SIZE..][..TABLE_SIZE];
+        let start = (s.x0 - self.columns.0) as usize;
+        let cells = &mut row[start..start + s.n as usize];
+        for (cell, &fx) in cells.iter_mut().zip(&s.fx) {
+            let weight = table_row[fx as usize];
+            if weight != 0.0 {
+                let wf = weight as f64;
+                cell[0] += wf * s.l.x as f64;
+                cell[1] += wf * s.l.y as f64;
+                cell[2] += wf * s.l.z as f64;
+                cell[3] += wf;
+            }
+        }
+    }
+
     /// The radiance after the film's luminance clamp (pbrt-v3's maxsampleluminance).
     #[inline]
     fn clamped(&self, l: Spectrum) -> Spectrum {
@@ -178,6 +256,7 @@ impl Film {
                 max_luminance: settings.max_sample_luminance,
             },
             settings,
+            prepared: Vec::new(),
         }
     }
 
@@ -221,6 +300,31 @@ impl Film {
         let (lo, hi) = (first.0.y.floor() - 0.5 - ry, last.0.y.floor() + 0.5 + ry);
         let w = self.settings.size().0 as usize;
         let splat = &self.splat;
+        if splat.prepare_pays() {
+            samples
+                .par_iter()
+                .map(|&(p, l)| splat.prepare(p, l))
+                .collect_into_vec(&mut self.prepared);
+            let prepared = &self.prepared;
+            self.sums
+                .par_chunks_mut(w)
+                .enumerate()
+                .for_each(|(row_index, row)| {
+                    let y = row_index as i64 + cy0;
+                    let yf = y as f32;
+                    if yf < lo || yf > hi {
+                        return;
+                    }
+                    // As below.
+                    let (top, bottom) = ((yf + 0.5 - ry).floor(), (yf + 0.5 + ry).floor());
+                    let from = prepared.partition_point(|s| s.p.y.floor() < top);
+                    let to = prepared.partition_point(|s| s.p.y.floor() <= bottom);
+                    for s in &prepared[from..to] {
+                        splat.row_prepared(row, y, s);
+                    }
+                });
+            return;
+        }
         self.sums
             .par_chunks_mut(w)
             .enumerate()

@@ -267,15 +267,7 @@ impl Light {
                         (q, n, area_to_solid_angle(p, q, n, *area)?)
                     }
                 };
-                let wi = (q - p).normalize_or_zero();
-                if pdf <= 0.0 || !pdf.is_finite() || wi == Vec3::ZERO {
-                    return None;
-                }
-                let li = area_emission(*l_emit, *two_sided, n, -wi);
-                if li == Spectrum::ZERO {
-                    return None;
-                }
-                Some(LightSample { wi, li, pdf, p: q })
+                area_light_sample(p, q, n, pdf, *l_emit, *two_sided)
             }
             Light::Infinite {
                 l,
@@ -313,6 +305,35 @@ impl Light {
                     p: p + wi * (2.0 * world_radius),
                 })
             }
+        }
+    }
+
+    /// The point and normal that [`Light::sample_li`] picks with `u` on an area light whose
+    /// choice does not depend on the receiving point (every shape but the sphere, which samples
+    /// the cone it subtends); `None` for every other light.
+    pub fn sample_point(&self, world: &Geometry, u: Vec2) -> Option<(Vec3, Vec3)> {
+        match self {
+            Light::Area { shape, .. } if !matches!(shape.kind, PrimKind::Sphere(_)) => {
+                Some(sample_area(world, shape.kind, u))
+            }
+            _ => None,
+        }
+    }
+
+    /// [`Light::sample_li`] from `p` given the point `q` and normal `n` that
+    /// [`Light::sample_point`] chose: the same sample, without sampling the shape again.
+    pub fn sample_li_at_point(&self, p: Vec3, q: Vec3, n: Vec3) -> Option<LightSample> {
+        match self {
+            Light::Area {
+                l_emit,
+                two_sided,
+                area,
+                ..
+            } => {
+                let pdf = area_to_solid_angle(p, q, n, *area)?;
+                area_light_sample(p, q, n, pdf, *l_emit, *two_sided)
+            }
+            _ => None,
         }
     }
 
@@ -410,6 +431,28 @@ pub fn prim_area(world: &Geometry, kind: PrimKind) -> f32 {
         PrimKind::Disk(i) => world.disks[i as usize].area(),
         PrimKind::Cylinder(i) => world.cylinders[i as usize].area(),
     }
+}
+
+/// The sample of an area light seen from `p` when the point `q` (normal `n`) was picked with
+/// solid-angle density `pdf`; `None` when it contributes nothing.
+#[inline]
+fn area_light_sample(
+    p: Vec3,
+    q: Vec3,
+    n: Vec3,
+    pdf: f32,
+    l_emit: Spectrum,
+    two_sided: bool,
+) -> Option<LightSample> {
+    let wi = (q - p).normalize_or_zero();
+    if pdf <= 0.0 || !pdf.is_finite() || wi == Vec3::ZERO {
+        return None;
+    }
+    let li = area_emission(l_emit, two_sided, n, -wi);
+    if li == Spectrum::ZERO {
+        return None;
+    }
+    Some(LightSample { wi, li, pdf, p: q })
 }
 
 /// Converts the uniform area density 1/area at `q` (normal `n`) to solid angle seen from `p`.

@@ -117,6 +117,56 @@ const VOXEL_SAMPLES: u32 = 128;
 /// well sampled while giving the other lights their due.
 const INFINITE_LIGHT_WEIGHT: f32 = 1.0 / (4.0 * std::f32::consts::PI);
 
+/// Lights up to which [`VoxelSampling`] keeps each area light's sampled points (128 points
+/// and normals per light: 3 KiB).
+const MAX_CACHED_LIGHTS: usize = 4096;
+
+/// The points and normals an area light picks with each of the voxel samples' `u`.
+type LightPoints = Box<[(Vec3, Vec3)]>;
+
+/// What every voxel's computation shares: the Halton points (position in the voxel, light
+/// sample) and, for area lights whose sample does not depend on the receiving point, the
+/// points and normals those light samples pick. Computing them once instead of per voxel
+/// gives the same values.
+struct VoxelSampling {
+    /// Position in the voxel (in [0, 1)^3) and light sample `u`, per sample.
+    points: Vec<(Vec3, Vec2)>,
+    /// Per light: the point and normal picked by each sample's `u`, when cached.
+    light_points: Vec<Option<LightPoints>>,
+}
+
+impl VoxelSampling {
+    fn new(lights: &[Light], world: &Geometry) -> Self {
+        let points: Vec<(Vec3, Vec2)> = (0..VOXEL_SAMPLES)
+            .map(|i| {
+                let t = Vec3::new(
+                    radical_inverse(2, i),
+                    radical_inverse(3, i),
+                    radical_inverse(5, i),
+                );
+                let u = Vec2::new(radical_inverse(7, i), radical_inverse(11, i));
+                (t, u)
+            })
+            .collect();
+        let light_points = lights
+            .iter()
+            .map(|light| {
+                if lights.len() > MAX_CACHED_LIGHTS {
+                    return None;
+                }
+                points
+                    .iter()
+                    .map(|&(_, u)| light.sample_point(world, u))
+                    .collect()
+            })
+            .collect();
+        Self {
+            points,
+            light_points,
+        }
+    }
+}
+
 /// pbrt-v3's SpatialLightDistribution: a grid over the scene's bounds, each voxel's light
 /// distribution computed on first use. The computation is a pure function of the voxel, so
 /// the result does not depend on which thread gets there first.
@@ -125,6 +175,7 @@ pub struct SpatialLightDistribution {
     extent: Vec3,
     n: [u32; 3],
     voxels: Vec<OnceLock<LightPmf>>,
+    sampling: OnceLock<VoxelSampling>,
 }
 
 impl SpatialLightDistribution {
@@ -150,6 +201,7 @@ impl SpatialLightDistribution {
             extent,
             n,
             voxels: (0..count).map(|_| OnceLock::new()).collect(),
+            sampling: OnceLock::new(),
         }
     }
 
@@ -186,17 +238,21 @@ impl SpatialLightDistribution {
             self.lo + corner(0) * self.extent,
             self.lo + corner(1) * self.extent,
         );
+        let sampling = self
+            .sampling
+            .get_or_init(|| VoxelSampling::new(lights, world));
         let mut contrib = vec![0.0f32; lights.len()];
-        for i in 0..VOXEL_SAMPLES {
-            let t = Vec3::new(
-                radical_inverse(2, i),
-                radical_inverse(3, i),
-                radical_inverse(5, i),
-            );
+        for (i, &(t, u)) in sampling.points.iter().enumerate() {
             let p = a + (b - a) * t;
-            let u = Vec2::new(radical_inverse(7, i), radical_inverse(11, i));
-            for (c, light) in contrib.iter_mut().zip(lights) {
-                if let Some(s) = light.sample_li(world, p, u) {
+            for ((c, light), cached) in contrib.iter_mut().zip(lights).zip(&sampling.light_points) {
+                let sample = match cached {
+                    Some(qn) => {
+                        let (q, n) = qn[i];
+                        light.sample_li_at_point(p, q, n)
+                    }
+                    None => light.sample_li(world, p, u),
+                };
+                if let Some(s) = sample {
                     if s.pdf > 0.0 {
                         let mut v = crate::spectrum_luminance(s.li) / s.pdf;
                         if matches!(light, Light::Infinite { .. }) {

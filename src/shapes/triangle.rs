@@ -171,9 +171,25 @@ pub fn intersect_triangle_vertices(
     r: &TriangleRay,
     t_max: f32,
 ) -> Option<TriangleHit> {
+    // One version per permutation: with the axes known at compile time, permuting the
+    // vertices is plain register moves instead of three indexed selections per coordinate.
+    match (r.kx, r.ky, r.kz) {
+        (1, 2, 0) => intersect_permuted::<1, 2, 0>(p, r, t_max),
+        (2, 0, 1) => intersect_permuted::<2, 0, 1>(p, r, t_max),
+        _ => intersect_permuted::<0, 1, 2>(p, r, t_max),
+    }
+}
+
+/// [`intersect_triangle_vertices`] for the ray's axis permutation (`KX`, `KY`, `KZ`).
+#[inline(always)]
+fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
+    p: &[Vec3; 3],
+    r: &TriangleRay,
+    t_max: f32,
+) -> Option<TriangleHit> {
+    debug_assert_eq!((r.kx, r.ky, r.kz), (KX, KY, KZ));
     let [p0, p1, p2] = *p;
-    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
-    let permute = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
+    let permute = |v: Vec3| Vec3::new(v[KX], v[KY], v[KZ]);
     // Translate to the ray origin and permute.
     let mut p0t = permute(p0 - r.o);
     let mut p1t = permute(p1 - r.o);
