@@ -1,11 +1,13 @@
 //! The `acr` command line: subcommands and their arguments.
 
+use crate::aov::{parse_aovs, write_aov, AovRequest};
 use crate::film::Film;
 use crate::image_io::{write_image, RgbImage};
-use crate::integrator::Integrator;
-use crate::render::{kernel_from_desc, render, spp_from_desc, MAX_SPP};
+use crate::registry::{choose, Overrides};
+use crate::render::{render, rendering_space, MAX_SPP};
 use crate::scene::Scene;
 use crate::stats::{peak_rss_mb, Seconds, Stats};
+use acr_plugins::{SamplerSetup, Setting};
 use clap::{Parser, Subcommand};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -31,6 +33,8 @@ pub enum Command {
     },
     /// Render a scene to an image (.exr, .png or .pfm).
     Render(RenderArgs),
+    /// List every plugin (samplers, filters, integrators) with its parameters and defaults.
+    Plugins,
     /// Compare an image with a reference: MSE, relMSE and PSNR (linear radiance).
     Diff {
         /// The image to judge (.exr, .pfm, .hdr or .png).
@@ -55,6 +59,28 @@ pub struct RenderArgs {
     /// Samples per pixel (overrides the scene's Sampler).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64))]
     pub spp: Option<u32>,
+    /// Stop after this many seconds of rendering, at the end of the pass under way (every
+    /// pixel keeps as many samples as the others); --spp or the scene's budget still caps it.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub time_limit: Option<f64>,
+    /// The sampler, by name (overrides the scene's Sampler; see `acr plugins`).
+    #[arg(long)]
+    pub sampler: Option<String>,
+    /// The reconstruction filter, by name (overrides the scene's PixelFilter).
+    #[arg(long)]
+    pub filter: Option<String>,
+    /// The integrator, by name (overrides the scene's Integrator).
+    #[arg(long)]
+    pub integrator: Option<String>,
+    /// A plugin parameter, KIND.PARAM=VALUE (e.g. sampler.pixelsamples=64, filter.alpha=1);
+    /// repeatable, overrides the scene's.
+    #[arg(long = "set", value_name = "KIND.PARAM=VALUE")]
+    pub set: Vec<String>,
+    /// Extra per-pixel outputs, NAME=FILE[,NAME=FILE]: spp (samples per pixel), variance (of
+    /// each pixel's mean). An .exr holds the values; a .png is false colour scaled by the
+    /// largest value (the scale is printed and stored in the PNG). Repeatable.
+    #[arg(long, value_name = "NAME=FILE")]
+    pub aov: Vec<String>,
     /// Worker threads (default: every core).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -74,6 +100,10 @@ pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Parse { scene } => parse(&scene),
         Command::Render(args) => render_command(&args),
+        Command::Plugins => {
+            print!("{}", crate::registry::describe());
+            Ok(())
+        }
         Command::Diff {
             image,
             reference,
@@ -119,33 +149,25 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
 
     let mut warnings = desc.warnings.clone();
     let scene = Scene::build(&desc, &mut warnings).map_err(|e| e.to_string())?;
-    let integrator =
-        Integrator::new(desc.integrator.as_ref(), &mut warnings).map_err(|e| e.to_string())?;
-    let kernel = kernel_from_desc(desc.filter.as_ref()).map_err(|e| e.to_string())?;
-    let filter_name = desc
-        .filter
-        .as_ref()
-        .map_or("box", |f| f.kind.as_str())
-        .to_owned();
-    let scene_spp = spp_from_desc(desc.sampler.as_ref()).map_err(|e| e.to_string())?;
-    let spp = args.spp.unwrap_or(scene_spp);
-    if let Some(s) = &desc.sampler {
-        if s.kind != "sobol" {
-            // Until the sampler plugins exist (issue 4) every scene gets one sampler.
-            warnings.push(acr_parser::Warning::at(
-                &s.loc,
-                format!(
-                    "sampler \"{}\" is not available yet; using \"sobol\"",
-                    s.kind
-                ),
-            ));
-        }
-        // Sampler parameters acr does not use yet are not worth a warning each.
-        for p in s.params.iter() {
-            p.mark_used();
-        }
-    }
+    let overrides = Overrides {
+        sampler: args.sampler.clone(),
+        filter: args.filter.clone(),
+        integrator: args.integrator.clone(),
+        settings: args
+            .set
+            .iter()
+            .map(|s| Setting::parse(s))
+            .collect::<Result<_, _>>()
+            .map_err(|e| e.to_string())?,
+    };
+    let setup = || SamplerSetup {
+        space: rendering_space(&scene),
+        spp: args.spp,
+        seed: args.seed,
+    };
+    let mut plugins = choose(&desc, &overrides, setup, &mut warnings).map_err(|e| e.to_string())?;
     if let Some(a) = &desc.accelerator {
+        // acr has one acceleration structure; pbrt-v3's choice of its own is moot.
         for p in a.params.iter() {
             p.mark_used();
         }
@@ -161,9 +183,20 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     }
     let output = output_path(args, scene.film.filename.as_deref());
     check_writable(&output)?;
+    let aovs: Vec<AovRequest> = args
+        .aov
+        .iter()
+        .map(|a| parse_aovs(a))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    for a in &aovs {
+        check_writable(&a.path)?;
+    }
     let t_built = Instant::now();
 
-    let mut film = Film::new(scene.film.clone(), kernel);
+    let mut film = Film::new(scene.film.clone(), plugins.filter.kernel());
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let bar = show_progress.then(|| {
         let b = indicatif::ProgressBar::new(0);
@@ -175,20 +208,39 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         );
         b
     });
-    let counts = render(&scene, &integrator, &mut film, spp, args.seed, bar.as_ref());
+    let spp = plugins.sampler.spp();
+    let counts = render(
+        &scene,
+        &plugins.integrator,
+        plugins.sampler.as_mut(),
+        &mut film,
+        args.seed,
+        args.time_limit.map(std::time::Duration::from_secs_f64),
+        bar.as_ref(),
+    );
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     let t_rendered = Instant::now();
 
+    let pixels = plugins
+        .filter
+        .reconstruct(&film, plugins.sampler.partition());
     let (w, h) = scene.film.size();
+    let scale = scene.film.scale;
     let image = RgbImage {
         width: w as usize,
         height: h as usize,
-        pixels: film.pixels(),
+        pixels: pixels.into_iter().map(|c| c * scale).collect(),
     };
     let t_reconstructed = Instant::now();
     write_image(&output, &image).map_err(|e| format!("{}: {e}", output.display()))?;
+    for a in &aovs {
+        let line = write_aov(a, w as usize, h as usize, film.pixel_stats())?;
+        if !args.quiet {
+            eprintln!("{line}");
+        }
+    }
     let t_written = Instant::now();
 
     let render_s = (t_rendered - t_built).as_secs_f64();
@@ -201,9 +253,10 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         rays: counts.rays,
         threads: rayon::current_num_threads(),
         seed: args.seed,
-        sampler: "sobol".into(),
-        filter: filter_name,
-        integrator: integrator.name().into(),
+        sampler: plugins.sampler.name().into(),
+        filter: plugins.filter.name().into(),
+        integrator: plugins.integrator.name().into(),
+        halted: counts.halted,
         dims: scene.dims.names().into_iter().map(str::to_owned).collect(),
         clusters: None,
         dropped_samples: counts.dropped,
@@ -233,6 +286,13 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             counts.dropped, counts.samples
         );
     }
+    if counts.halted && !args.quiet {
+        eprintln!(
+            "time limit: stopped after {} of {} samples per pixel",
+            counts.samples / (u64::from(w) * u64::from(h)).max(1),
+            spp
+        );
+    }
     if !args.quiet {
         eprintln!(
             "{}: {w}x{h}, {spp} spp, {:.2} s render, {:.2} Mrays/s, {} threads -> {}",
@@ -244,6 +304,14 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// A time limit in seconds: finite and positive.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v < 1e9 => Ok(v),
+        _ => Err(format!("\"{s}\" is not a positive number of seconds")),
+    }
 }
 
 fn diff_command(image: &Path, reference: &Path, json: bool) -> Result<(), String> {

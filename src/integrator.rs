@@ -11,7 +11,8 @@ use crate::lightdistrib::LightStrategy;
 use crate::sampling::power_heuristic;
 use crate::scene::Scene;
 use crate::stream::SampleStream;
-use acr_parser::{Error, PluginDesc, Result, Warning};
+use acr_parser::{Error, ParamList, ParamType, Result};
+use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
 /// Most consecutive pass-through surfaces (`Material ""`) a ray may cross before it is
 /// abandoned: a guard against a ray trapped between coincident interfaces.
@@ -56,87 +57,111 @@ pub struct Radiance {
     pub rays: u32,
 }
 
-/// The names the registry knows.
-pub const INTEGRATORS: &[&str] = &["path", "directlighting"];
+/// Builds an integrator from its checked parameters.
+pub type IntegratorBuild = fn(&Choice) -> Result<Integrator>;
+
+/// Every integrator, by name.
+pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "path",
+            doc: "path tracing: light and BSDF sampling with MIS, Russian roulette (pbrt-v3 path)",
+            params: &[
+                ParamSpec::new(
+                    "maxdepth",
+                    ParamType::Integer,
+                    "5",
+                    "longest path, in bounces",
+                ),
+                ParamSpec::new(
+                    "rrthreshold",
+                    ParamType::Float,
+                    "1",
+                    "Russian roulette once the throughput's largest channel is below this",
+                ),
+                ParamSpec::new(
+                    "lightsamplestrategy",
+                    ParamType::String,
+                    "spatial",
+                    "how a light is chosen: uniform, power or spatial",
+                ),
+            ],
+        },
+        build: Integrator::path,
+    },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "directlighting",
+            doc: "direct lighting plus specular reflection and refraction (pbrt-v3 directlighting)",
+            params: &[
+                ParamSpec::new(
+                    "maxdepth",
+                    ParamType::Integer,
+                    "5",
+                    "specular recursion depth",
+                ),
+                ParamSpec::new(
+                    "strategy",
+                    ParamType::String,
+                    "all",
+                    "all: every light at each point; one: one light chosen uniformly",
+                ),
+            ],
+        },
+        build: Integrator::direct,
+    },
+];
+
+/// `maxdepth`, which must not be negative.
+fn max_depth(params: &ParamList) -> Result<u32> {
+    let d = params.int_or("maxdepth", 5)?;
+    u32::try_from(d).map_err(|_| match params.get("maxdepth") {
+        Some(p) => Error::at(&p.loc, format!("maxdepth {d} is negative")),
+        None => Error::file("maxdepth", "negative"),
+    })
+}
 
 impl Integrator {
-    /// From the `Integrator` directive (pbrt-v3's defaults: path, maxdepth 5). pbrt-v3
-    /// integrators acr lacks fall back to `path` with a warning: they estimate the same image.
-    pub fn new(desc: Option<&PluginDesc>, warnings: &mut Vec<Warning>) -> Result<Self> {
-        let Some(p) = desc else {
-            return Ok(Integrator::Path {
-                max_depth: 5,
-                rr_threshold: 1.0,
-                light_strategy: LightStrategy::Spatial,
+    /// `path` from its parameters (pbrt-v3's defaults: maxdepth 5, rrthreshold 1).
+    pub fn path(c: &Choice) -> Result<Self> {
+        let params = &c.params;
+        let name = params.string("lightsamplestrategy")?.unwrap_or("spatial");
+        let Some(light_strategy) = LightStrategy::from_name(name) else {
+            let p = params.get("lightsamplestrategy");
+            let message =
+                format!("lightsamplestrategy \"{name}\" is not uniform, power or spatial");
+            return Err(match p {
+                Some(p) => Error::at(&p.loc, message),
+                None => Error::file("lightsamplestrategy", message),
             });
         };
-        let params = &p.params;
-        let max_depth = |default| -> Result<u32> {
-            let d = params.int_or("maxdepth", default)?;
-            u32::try_from(d).map_err(|_| {
-                let loc = params.get("maxdepth").map_or(&p.loc, |x| &x.loc);
-                Error::at(loc, format!("maxdepth {d} is negative"))
-            })
-        };
-        match p.kind.as_str() {
-            "path" => {
-                let name = params.string("lightsamplestrategy")?.unwrap_or("spatial");
-                let Some(light_strategy) = LightStrategy::from_name(name) else {
-                    let loc = params.get("lightsamplestrategy").map_or(&p.loc, |x| &x.loc);
-                    return Err(Error::at(
-                        loc,
-                        format!("lightsamplestrategy \"{name}\" is not uniform, power or spatial"),
-                    ));
-                };
-                Ok(Integrator::Path {
-                    max_depth: max_depth(5)?,
-                    rr_threshold: params.float_or("rrthreshold", 1.0)? as f32,
-                    light_strategy,
-                })
-            }
-            "directlighting" => {
-                let strategy = match params.string("strategy")?.unwrap_or("all") {
-                    "all" => DirectStrategy::All,
-                    "one" => DirectStrategy::One,
-                    other => {
-                        let loc = params.get("strategy").map_or(&p.loc, |x| &x.loc);
-                        return Err(Error::at(
-                            loc,
-                            format!("strategy \"{other}\" is not \"all\" or \"one\""),
-                        ));
-                    }
-                };
-                Ok(Integrator::Direct {
-                    max_depth: max_depth(5)?,
-                    strategy,
-                })
-            }
-            "bdpt" | "mlt" | "sppm" | "volpath" | "whitted" | "ambientocclusion" => {
-                warnings.push(Warning::at(
-                    &p.loc,
-                    format!(
-                        "integrator \"{}\" is not supported; using \"path\" (maxdepth 5)",
-                        p.kind
-                    ),
-                ));
-                Ok(Integrator::Path {
-                    max_depth: max_depth(5)?,
-                    rr_threshold: 1.0,
-                    light_strategy: LightStrategy::Spatial,
-                })
-            }
+        Ok(Integrator::Path {
+            max_depth: max_depth(params)?,
+            rr_threshold: params.float_or("rrthreshold", 1.0)? as f32,
+            light_strategy,
+        })
+    }
+
+    /// `directlighting` from its parameters (pbrt-v3's defaults: maxdepth 5, strategy all).
+    pub fn direct(c: &Choice) -> Result<Self> {
+        let params = &c.params;
+        let strategy = match params.string("strategy")?.unwrap_or("all") {
+            "all" => DirectStrategy::All,
+            "one" => DirectStrategy::One,
             other => {
-                let hint = acr_parser::closest(other, INTEGRATORS.iter().copied())
-                    .map_or(String::new(), |k| format!(" (did you mean {k}?)"));
-                Err(Error::at(
-                    &p.loc,
-                    format!(
-                        "unknown integrator \"{other}\"{hint}; known: {}",
-                        INTEGRATORS.join(", ")
-                    ),
-                ))
+                let message = format!("strategy \"{other}\" is not \"all\" or \"one\"");
+                return Err(match params.get("strategy") {
+                    Some(p) => Error::at(&p.loc, message),
+                    None => Error::file("strategy", message),
+                });
             }
-        }
+        };
+        Ok(Integrator::Direct {
+            max_depth: max_depth(params)?,
+            strategy,
+        })
     }
 
     /// The name, as the stats file reports it.

@@ -2,10 +2,11 @@
 //! command line; the parser and the plugins live in their own crates.
 
 pub mod accel;
+pub mod aov;
 pub mod bsdf;
 pub mod camera;
 pub mod cli;
-pub mod film;
+pub use acr_plugins::film;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;
@@ -14,6 +15,7 @@ pub mod lightdistrib;
 pub mod material;
 pub mod metrics;
 pub mod microfacet;
+pub mod registry;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -2,114 +2,27 @@
 //! added to the film in a fixed order, so the image depends on the scene, seed and budget only.
 
 use crate::camera::CameraSample;
-use crate::film::Film;
 use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
 use crate::integrator::Integrator;
 use crate::scene::Scene;
 use crate::stream::SampleStream;
-use acr_parser::{Error, PluginDesc, Result};
-use acr_plugins::filters::{
-    BoxFilter, GaussianFilter, LanczosSincFilter, MitchellFilter, TriangleFilter,
-};
-use acr_plugins::Kernel;
+use acr_plugins::sampler::SOBOL_DIMS_USED;
+use acr_plugins::{Film, RenderingSpace, SamplePoint, Sampler};
 use rayon::prelude::*;
+use std::time::{Duration, Instant};
 
-/// Samples per batch: enough to keep every thread busy, few enough to report progress often.
-const BATCH_SAMPLES: usize = 1 << 15;
+pub use acr_plugins::sampler::MAX_SPP;
 
-/// Largest accepted samples per pixel.
-pub const MAX_SPP: u32 = 1 << 20;
-
-/// The names of the filters acr knows.
-pub const FILTERS: &[&str] = &["box", "triangle", "gaussian", "mitchell", "sinc"];
-
-/// The pixel filter from the `PixelFilter` directive (pbrt-v3's default: box, radius 0.5).
-pub fn kernel_from_desc(desc: Option<&PluginDesc>) -> Result<Kernel> {
-    let Some(p) = desc else {
-        return Ok(Kernel::Box(BoxFilter::new(0.5, 0.5)));
-    };
-    let params = &p.params;
-    let radius = |default: f64| -> Result<(f32, f32)> {
-        let rx = params.float_or("xwidth", default)? as f32;
-        let ry = params.float_or("ywidth", default)? as f32;
-        if !(rx > 0.0 && ry > 0.0 && rx <= 64.0 && ry <= 64.0) {
-            return Err(Error::at(
-                &p.loc,
-                format!("filter radius {rx} x {ry} is out of range (0, 64]"),
-            ));
-        }
-        Ok((rx, ry))
-    };
-    Ok(match p.kind.as_str() {
-        "box" => {
-            let (rx, ry) = radius(0.5)?;
-            Kernel::Box(BoxFilter::new(rx, ry))
-        }
-        "triangle" => {
-            let (rx, ry) = radius(2.0)?;
-            Kernel::Triangle(TriangleFilter::new(rx, ry))
-        }
-        "gaussian" => {
-            let (rx, ry) = radius(2.0)?;
-            Kernel::Gaussian(GaussianFilter::new(
-                rx,
-                ry,
-                params.float_or("alpha", 2.0)? as f32,
-            ))
-        }
-        "mitchell" => {
-            let (rx, ry) = radius(2.0)?;
-            Kernel::Mitchell(MitchellFilter::new(
-                rx,
-                ry,
-                params.float_or("B", 1.0 / 3.0)? as f32,
-                params.float_or("C", 1.0 / 3.0)? as f32,
-            ))
-        }
-        "sinc" => {
-            let (rx, ry) = radius(4.0)?;
-            Kernel::Sinc(LanczosSincFilter::new(
-                rx,
-                ry,
-                params.float_or("tau", 3.0)? as f32,
-            ))
-        }
-        other => {
-            let hint = acr_parser::closest(other, FILTERS.iter().copied())
-                .map_or(String::new(), |k| format!(" (did you mean {k}?)"));
-            return Err(Error::at(
-                &p.loc,
-                format!(
-                    "unknown filter \"{other}\"{hint}; known: {}",
-                    FILTERS.join(", ")
-                ),
-            ));
-        }
-    })
-}
-
-/// Samples per pixel asked for by the `Sampler` directive (pbrt-v3's defaults).
-pub fn spp_from_desc(desc: Option<&PluginDesc>) -> Result<u32> {
-    let Some(p) = desc else {
-        return Ok(16);
-    };
-    let params = &p.params;
-    let spp = if p.kind == "stratified" {
-        params.int_or("xsamples", 4)? as i64 * params.int_or("ysamples", 4)? as i64
-    } else {
-        params.int_or("pixelsamples", 16)? as i64
-    };
-    check_spp(spp, &p.loc)
-}
-
-fn check_spp(spp: i64, loc: &acr_parser::Loc) -> Result<u32> {
-    if spp < 1 || spp > MAX_SPP as i64 {
-        return Err(Error::at(
-            loc,
-            format!("{spp} samples per pixel is out of range (1 to {MAX_SPP})"),
-        ));
+/// The part of the rendering space a scene's render covers: its film's crop and its dims.
+pub fn rendering_space(scene: &Scene) -> RenderingSpace {
+    let [x0, x1, y0, y1] = scene.film.crop;
+    RenderingSpace {
+        x0,
+        x1,
+        y0,
+        y1,
+        dims: scene.dims,
     }
-    Ok(spp as u32)
 }
 
 /// The raster position of offset `u` in [0, 1)^2 within pixel (px, py). Rounding can carry
@@ -131,74 +44,72 @@ pub struct RenderCounts {
     pub rays: u64,
     /// Samples whose radiance was NaN, infinite or negative, dropped before the film.
     pub dropped: u64,
+    /// The time limit stopped the render before the sampler's budget was spent.
+    pub halted: bool,
 }
 
-/// Renders `scene` at `spp` samples per pixel into `film`.
+/// Renders `scene` with `sampler`'s points into `film`, until the sampler's budget is spent
+/// or, with a `time_limit`, until the pass running when the limit passes is complete.
 pub fn render(
     scene: &Scene,
     integrator: &Integrator,
+    sampler: &mut dyn Sampler,
     film: &mut Film,
-    spp: u32,
     seed: u64,
+    time_limit: Option<Duration>,
     progress: Option<&indicatif::ProgressBar>,
 ) -> RenderCounts {
-    let [x0, x1, y0, y1] = scene.film.crop;
-    let width = (x1 - x0) as usize;
-    let full_width = scene.film.resolution.0 as u64;
-    let pixels = width * (y1 - y0) as usize;
-    let spp_us = spp as usize;
-    let total = pixels * spp_us;
-    let dims = scene.dims;
+    let start = Instant::now();
+    let full_width = u64::from(scene.film.resolution.0);
+    let space = rendering_space(scene);
     let mut counts = RenderCounts::default();
-    let mut start = 0usize;
     if let Some(p) = progress {
-        p.set_length(total as u64);
+        p.set_length(space.pixels() * u64::from(sampler.spp()));
     }
     // Reused by every batch: a fresh half-megabyte vector per batch costs page faults.
-    let mut results: Vec<(Vec2, Spectrum, u32)> = Vec::new();
+    let mut batch: Vec<SamplePoint> = Vec::new();
+    let mut results: Vec<(Spectrum, u32)> = Vec::new();
+    let mut radiance: Vec<[f32; 3]> = Vec::new();
     let mut valid: Vec<(Vec2, Spectrum)> = Vec::new();
-    while start < total {
-        // Whole pixels per batch, so a pixel's samples stay together.
-        let end = (start + BATCH_SAMPLES.div_ceil(spp_us).max(1) * spp_us).min(total);
-        (start..end)
-            .into_par_iter()
-            .map(|k| {
-                let (pixel, index) = (k / spp_us, (k % spp_us) as u32);
-                let px = x0 + (pixel % width) as u32;
-                let py = y0 + (pixel / width) as u32;
-                let key = py as u64 * full_width + px as u64;
-                let mut stream = SampleStream::new(key, index, seed, 0);
-                let film_pos = in_pixel(px, py, stream.next_2d());
-                let time = if dims.time { stream.next_1d() } else { 0.5 };
-                let lens = if dims.lens {
-                    stream.next_2d()
-                } else {
-                    Vec2::splat(0.5)
-                };
+    while sampler.next_batch(&mut batch) {
+        batch
+            .par_iter()
+            .map(|q| {
+                let key = u64::from(q.pixel[1]) * full_width + u64::from(q.pixel[0]);
+                // The integrator's decisions come after the dims the sampler drew.
+                let mut stream = SampleStream::new(key, q.index, seed, SOBOL_DIMS_USED);
                 let ray = scene.camera.generate_ray(&CameraSample {
-                    film: film_pos,
-                    lens,
-                    time,
+                    film: Vec2::from(q.film),
+                    lens: Vec2::from(q.lens),
+                    time: q.time,
                 });
                 let r = integrator.li(scene, ray, &mut stream);
-                (film_pos, r.l, r.rays)
+                (r.l, r.rays)
             })
             .collect_into_vec(&mut results);
         valid.clear();
-        for &(pos, l, rays) in &results {
-            counts.rays += rays as u64;
+        radiance.clear();
+        for (q, &(l, rays)) in batch.iter().zip(&results) {
+            counts.rays += u64::from(rays);
             if is_valid_radiance(l) {
-                valid.push((pos, l));
+                valid.push((Vec2::from(q.film), l));
+                radiance.push(l.to_array());
             } else {
                 counts.dropped += 1;
+                // NaN marks a dropped sample for adaptive samplers, which must skip it.
+                radiance.push([f32::NAN; 3]);
             }
         }
+        sampler.observe(&batch, &radiance);
         film.add_samples(&valid);
-        counts.samples += (end - start) as u64;
+        counts.samples += batch.len() as u64;
         if let Some(p) = progress {
-            p.set_position(end as u64);
+            p.set_position(counts.samples);
         }
-        start = end;
+        if time_limit.is_some_and(|t| start.elapsed() >= t) {
+            sampler.halt();
+        }
     }
+    counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
     counts
 }

@@ -27,33 +27,7 @@ pub struct Surface {
     pub area_light: Option<u32>,
 }
 
-/// The dimensions of the rendering space beyond the image plane.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Dims {
-    /// Something moves while the shutter is open: sample time.
-    pub time: bool,
-    /// The camera has a lens: sample the lens.
-    pub lens: bool,
-}
-
-impl Dims {
-    /// The names of the active dimensions, as the stats file reports them.
-    pub fn names(&self) -> Vec<&'static str> {
-        let mut v = vec!["x", "y"];
-        if self.time {
-            v.push("t");
-        }
-        if self.lens {
-            v.extend(["u", "v"]);
-        }
-        v
-    }
-
-    /// How many dimensions.
-    pub fn count(&self) -> usize {
-        2 + usize::from(self.time) + 2 * usize::from(self.lens)
-    }
-}
+pub use acr_plugins::Dims;
 
 /// A scene ready to render.
 pub struct Scene {

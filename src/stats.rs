@@ -46,6 +46,8 @@ pub struct Stats {
     pub integrator: String,
     /// Active dimensions of the rendering space, e.g. ["x","y","t"].
     pub dims: Vec<String>,
+    /// The time limit stopped the render before its budget was spent.
+    pub halted: bool,
     /// Clusters of the cluster sampler (null for other samplers).
     pub clusters: Option<u64>,
     /// Samples dropped for NaN, infinite or negative radiance.

@@ -83,8 +83,10 @@ impl SampleStream {
             dim: first_dim,
             block: [0.0; 4],
             block_set: u32::MAX,
+            // The index is hashed into the seed: PCG streams whose seeds and increments differ
+            // by small steps start out correlated.
             rng: Pcg32::new(
-                key ^ u64::from(index),
+                mix64(key ^ mix64(u64::from(index))),
                 mix64(key).wrapping_add(u64::from(index)),
             ),
         }

@@ -623,3 +623,293 @@ fn without_an_output_the_films_filename_is_used() {
     let img = read_image(&exr, false).unwrap();
     assert_eq!((img.width, img.height), (24, 16));
 }
+
+#[test]
+fn plugins_lists_every_plugin_with_its_parameters() {
+    let o = acr(["plugins"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    for name in [
+        "random",
+        "stratified",
+        "halton",
+        "sobol",
+        "box",
+        "triangle",
+        "gaussian",
+        "mitchell",
+        "sinc",
+        "path",
+        "directlighting",
+    ] {
+        assert!(
+            text.lines().any(|l| l.trim_start().starts_with(name)),
+            "{name} missing from:\n{text}"
+        );
+    }
+    for param in [
+        "integer pixelsamples",
+        "integer xsamples",
+        "bool jitter",
+        "float alpha",
+        "float B",
+        "float tau",
+        "integer maxdepth",
+    ] {
+        assert!(text.contains(param), "{param} missing");
+    }
+}
+
+/// The plugins a render used, from its stats file.
+fn plugins_used(stats: &serde_json::Value) -> [String; 3] {
+    ["sampler", "filter", "integrator"].map(|k| stats[k].as_str().unwrap_or("?").to_owned())
+}
+
+#[test]
+fn plugins_come_from_the_scene_and_the_command_line_overrides_them() {
+    let dir = TempDir::new("plugins");
+    let scene = dir.write(
+        "s.pbrt",
+        &small_scene("")
+            .replace(
+                "WorldBegin",
+                "Sampler \"stratified\" \"integer xsamples\" 2 \"integer ysamples\" 3\n\
+                 PixelFilter \"mitchell\" \"float B\" 0.5\nWorldBegin",
+            )
+            .replace("\"path\"", "\"directlighting\""),
+    );
+    let (out, stats) = (dir.join("a.exr"), dir.join("a.json"));
+    render_ok(&scene, &out, &["--stats", stats.to_str().unwrap()]);
+    let s = read_stats(&stats);
+    assert_eq!(
+        plugins_used(&s),
+        ["stratified", "mitchell", "directlighting"]
+    );
+    assert_eq!(s["spp"], 6, "xsamples x ysamples");
+    render_ok(
+        &scene,
+        &out,
+        &[
+            "--stats",
+            stats.to_str().unwrap(),
+            "--sampler",
+            "sobol",
+            "--filter",
+            "gaussian",
+            "--integrator",
+            "path",
+            "--set",
+            "sampler.pixelsamples=3",
+            "--set",
+            "filter.alpha=1.5",
+        ],
+    );
+    let s = read_stats(&stats);
+    assert_eq!(plugins_used(&s), ["sobol", "gaussian", "path"]);
+    assert_eq!(s["spp"], 3);
+    assert_eq!(s["samples"], 3 * 24 * 16);
+    // pbrt-v3's names acr lacks map to the nearest, with a warning.
+    let scene = dir.write(
+        "alias.pbrt",
+        &small_scene("").replace(
+            "WorldBegin",
+            "Sampler \"02sequence\" \"integer pixelsamples\" 2\nWorldBegin",
+        ),
+    );
+    let o = render_ok(&scene, &out, &["--stats", stats.to_str().unwrap()]);
+    assert!(stderr(&o).contains("\"02sequence\""), "{}", stderr(&o));
+    assert_eq!(read_stats(&stats)["sampler"], "sobol");
+    assert_eq!(read_stats(&stats)["spp"], 2);
+}
+
+#[test]
+fn unknown_plugins_and_parameters_are_located_errors_with_the_closest_name() {
+    let dir = TempDir::new("badplugins");
+    let out = dir.join("x.png");
+    let scene = dir.write("ok.pbrt", &small_scene(""));
+    let run = |args: &[&str]| {
+        let mut all = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        acr(&all)
+    };
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &["--sampler", "sobl"],
+            &["unknown sampler \"sobl\"", "\"sobol\"", "known: random"],
+        ),
+        (
+            &["--filter", "gausian"],
+            &["unknown filter", "\"gaussian\""],
+        ),
+        (
+            &["--integrator", "pth"],
+            &["unknown integrator", "\"path\""],
+        ),
+        (
+            &["--set", "sampler.pixelsampels=4"],
+            &["--set:1:9:", "\"pixelsamples\""],
+        ),
+        (
+            &["--filter", "gaussian", "--set", "filter.alpha=wide"],
+            &["--set:1:14:", "not a number"],
+        ),
+        (
+            &["--set", "filter.alpha=1"],
+            &["--set:1:8:", "filter \"box\" has no parameter \"alpha\""],
+        ),
+        (&["--set", "camera.fov=3"], &["unknown plugin kind"]),
+        (&["--aov", "sp=a.png"], &["unknown AOV", "\"spp\""]),
+        (&["--time-limit", "0"], &["positive number of seconds"]),
+        (&["--time-limit", "nan"], &["positive number of seconds"]),
+    ];
+    for (args, words) in cases {
+        let o = run(args);
+        assert_clean_failure(&o, &format!("{args:?}"));
+        let err = stderr(&o);
+        for w in *words {
+            assert!(err.contains(w), "{args:?}: no {w} in {err}");
+        }
+        assert!(!out.exists(), "{args:?}: wrote an image");
+    }
+    // In the scene: the directive's location.
+    let bad = dir.write(
+        "bad.pbrt",
+        &small_scene("").replace("WorldBegin", "Sampler \"haltn\"\nWorldBegin"),
+    );
+    let o = acr(["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_clean_failure(&o, "haltn");
+    let err = stderr(&o);
+    assert!(err.contains("bad.pbrt:5:1:"), "{err}");
+    assert!(err.contains("\"halton\""), "{err}");
+    // A parameter of the wrong type, in the scene: located at the parameter.
+    let bad = dir.write(
+        "badtype.pbrt",
+        &small_scene("").replace(
+            "WorldBegin",
+            "Sampler \"sobol\" \"float pixelsamples\" 4\nWorldBegin",
+        ),
+    );
+    let o = acr(["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_clean_failure(&o, "float pixelsamples");
+    let err = stderr(&o);
+    assert!(err.contains("badtype.pbrt:5:17:"), "{err}");
+    assert!(err.contains("is integer, not float"), "{err}");
+    // A misspelled parameter in the scene: a located warning, and the render goes on.
+    let typo = dir.write(
+        "typo.pbrt",
+        &small_scene("").replace(
+            "WorldBegin",
+            "Sampler \"sobol\" \"integer pixelsampels\" 4\nWorldBegin",
+        ),
+    );
+    let o = render_ok(&typo, &out, &[]);
+    let err = stderr(&o);
+    assert!(err.contains("typo.pbrt:5:17:"), "{err}");
+    assert!(err.contains("did you mean \"pixelsamples\""), "{err}");
+}
+
+#[test]
+fn aovs_write_samples_per_pixel_and_variance() {
+    let dir = TempDir::new("aov");
+    let scene = dir.write("s.pbrt", &small_scene(""));
+    let (spp_exr, spp_png, var_exr) = (
+        dir.join("spp.exr"),
+        dir.join("spp.png"),
+        dir.join("var.exr"),
+    );
+    let arg = format!("spp={},variance={}", spp_exr.display(), var_exr.display());
+    let o = render_ok(
+        &scene,
+        &dir.join("img.exr"),
+        &[
+            "--spp",
+            "5",
+            "--aov",
+            &arg,
+            "--aov",
+            &format!("spp={}", spp_png.display()),
+        ],
+    );
+    let _ = o;
+    let counts = read_image(&spp_exr, false).unwrap();
+    assert_eq!((counts.width, counts.height), (24, 16));
+    assert!(counts.pixels.iter().all(|c| c.x == 5.0), "5 samples each");
+    let var = read_image(&var_exr, false).unwrap();
+    assert!(var
+        .pixels
+        .iter()
+        .all(|c| c.is_finite() && c.min_element() >= 0.0));
+    // The sphere's noisy pixels have some variance; a pixel seeing only the sky has none.
+    assert!(var.pixels.iter().any(|c| c.max_element() > 0.0));
+    let png = read_image(&spp_png, true).unwrap();
+    assert_eq!((png.width, png.height), (24, 16));
+    // Every pixel has the highest count: white, the top of the scale.
+    assert!(png.pixels.iter().all(|c| c.min_element() > 0.99));
+    let bytes = std::fs::read(&spp_png).unwrap();
+    let needle = b"5 samples per pixel";
+    assert!(
+        bytes.windows(needle.len()).any(|w| w == needle),
+        "the scale is written into the PNG"
+    );
+}
+
+#[test]
+fn a_time_limit_stops_at_a_whole_pass_and_the_image_stays_complete() {
+    let dir = TempDir::new("timelimit");
+    let scene = dir.write("slow.pbrt", &example_scene("cornell-box.pbrt", 200, 200));
+    let (out, stats, spp_aov) = (dir.join("t.exr"), dir.join("t.json"), dir.join("spp.exr"));
+    let mut cmd = acr_command([
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--spp",
+        "100000",
+        "--time-limit",
+        "0.5",
+        "--stats",
+        stats.to_str().unwrap(),
+        "--aov",
+        &format!("spp={}", spp_aov.display()),
+    ]);
+    cmd.stderr(Stdio::piped()).stdout(Stdio::piped());
+    let o = output_within(cmd, Duration::from_secs(60));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = read_stats(&stats);
+    assert_eq!(s["halted"], true);
+    let samples = s["samples"].as_u64().unwrap();
+    assert!(samples > 0 && samples < 100_000 * 200 * 200);
+    // Whole passes: every pixel has the same count, and the image has no hole.
+    let counts = read_image(&spp_aov, false).unwrap();
+    let first = counts.pixels[0].x;
+    assert!(first >= 1.0);
+    assert!(counts.pixels.iter().all(|c| c.x == first));
+    assert_eq!(first as u64 * 200 * 200, samples);
+    let img = read_image(&out, false).unwrap();
+    let lit = img.pixels.iter().filter(|c| c.max_element() > 0.0).count();
+    assert!(lit > 200 * 200 * 9 / 10, "{lit} lit pixels");
+}
+
+#[test]
+fn every_sampler_gives_the_same_file_with_one_and_two_threads() {
+    let dir = TempDir::new("samplers");
+    let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 20, 14));
+    for sampler in ["random", "stratified", "halton", "sobol"] {
+        let run = |threads: &str| {
+            let out = dir.join(format!("{sampler}{threads}.exr"));
+            render_ok(
+                &scene,
+                &out,
+                &["--spp", "4", "--sampler", sampler, "--threads", threads],
+            );
+            std::fs::read(&out).unwrap()
+        };
+        assert!(run("1") == run("2"), "{sampler}: 1 and 2 threads differ");
+    }
+}

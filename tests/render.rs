@@ -3,10 +3,11 @@
 
 use acr::film::Film;
 use acr::geometry::Spectrum;
-use acr::integrator::Integrator;
 use acr::parser::{parse_file, parse_str, Param, ParamType, SceneDescription, Values};
-use acr::render::{kernel_from_desc, render};
+use acr::registry::{choose, Overrides};
+use acr::render::{render, rendering_space};
 use acr::scene::Scene;
+use acr_plugins::SamplerSetup;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -44,12 +45,31 @@ struct Rendered {
 fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> Rendered {
     let mut warnings = Vec::new();
     let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let integrator = Integrator::new(desc.integrator.as_ref(), &mut warnings).unwrap();
-    let kernel = kernel_from_desc(desc.filter.as_ref()).unwrap();
-    let mut film = Film::new(scene.film.clone(), kernel);
-    let counts = render(&scene, &integrator, &mut film, spp, seed, None);
+    let setup = || SamplerSetup {
+        space: rendering_space(&scene),
+        spp: Some(spp),
+        seed,
+    };
+    let mut plugins =
+        choose(desc, &Overrides::default(), setup, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+    let mut film = Film::new(scene.film.clone(), plugins.filter.kernel());
+    let counts = render(
+        &scene,
+        &plugins.integrator,
+        plugins.sampler.as_mut(),
+        &mut film,
+        seed,
+        None,
+        None,
+    );
+    let scale = scene.film.scale;
     Rendered {
-        pixels: film.pixels(),
+        pixels: plugins
+            .filter
+            .reconstruct(&film, None)
+            .into_iter()
+            .map(|c| c * scale)
+            .collect(),
         width: scene.film.size().0 as usize,
         dropped: counts.dropped,
     }

@@ -1,6 +1,9 @@
 //! `gaussian`: exp(-alpha d^2) shifted to reach zero at the radius (pbrt-v3: radius 2, alpha 2).
 
 use super::FilterKernel;
+use super::{finite, radius, Filter, FilterBuild, Splatting, XWIDTH, YWIDTH};
+use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
+use acr_parser::{ParamType, Result};
 
 /// The truncated Gaussian filter.
 #[derive(Clone, Debug)]
@@ -42,4 +45,33 @@ impl FilterKernel for GaussianFilter {
         }
         self.gaussian(x, self.exp_x) * self.gaussian(y, self.exp_y)
     }
+}
+
+/// The registry's entry.
+pub(super) const ENTRY: Entry<FilterBuild> = Entry {
+    info: PluginInfo {
+        kind: Kind::Filter,
+        name: "gaussian",
+        doc: "pbrt-v3 gaussian: exp(-alpha d^2), shifted to reach zero at the radius",
+        params: &[
+            ParamSpec::new("xwidth", ParamType::Float, "2", XWIDTH),
+            ParamSpec::new("ywidth", ParamType::Float, "2", YWIDTH),
+            ParamSpec::new(
+                "alpha",
+                ParamType::Float,
+                "2",
+                "falloff: larger is narrower",
+            ),
+        ],
+    },
+    build,
+};
+
+fn build(c: &Choice) -> Result<Box<dyn Filter>> {
+    let (rx, ry) = radius(&c.params, 2.0)?;
+    let alpha = finite(&c.params, "alpha", 2.0)?;
+    Ok(Box::new(Splatting::new(
+        "gaussian",
+        GaussianFilter::new(rx, ry, alpha),
+    )))
 }

@@ -1,6 +1,9 @@
 //! `mitchell`: the Mitchell-Netravali cubic with parameters B and C (pbrt-v3: radius 2, 1/3, 1/3).
 
 use super::FilterKernel;
+use super::{finite, radius, Filter, FilterBuild, Splatting, XWIDTH, YWIDTH};
+use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
+use acr_parser::{ParamType, Result};
 
 /// The Mitchell-Netravali filter.
 #[derive(Clone, Debug)]
@@ -51,4 +54,30 @@ impl FilterKernel for MitchellFilter {
         }
         self.mitchell_1d(x / self.rx) * self.mitchell_1d(y / self.ry)
     }
+}
+
+/// The registry's entry.
+pub(super) const ENTRY: Entry<FilterBuild> = Entry {
+    info: PluginInfo {
+        kind: Kind::Filter,
+        name: "mitchell",
+        doc: "pbrt-v3 mitchell: the Mitchell-Netravali cubic with parameters B and C",
+        params: &[
+            ParamSpec::new("xwidth", ParamType::Float, "2", XWIDTH),
+            ParamSpec::new("ywidth", ParamType::Float, "2", YWIDTH),
+            ParamSpec::new("B", ParamType::Float, "0.333333", "blur: the cubic's B"),
+            ParamSpec::new("C", ParamType::Float, "0.333333", "ringing: the cubic's C"),
+        ],
+    },
+    build,
+};
+
+fn build(c: &Choice) -> Result<Box<dyn Filter>> {
+    let (rx, ry) = radius(&c.params, 2.0)?;
+    let b = finite(&c.params, "B", 1.0 / 3.0)?;
+    let cc = finite(&c.params, "C", 1.0 / 3.0)?;
+    Ok(Box::new(Splatting::new(
+        "mitchell",
+        MitchellFilter::new(rx, ry, b, cc),
+    )))
 }

@@ -13,6 +13,11 @@ pub use mitchell::MitchellFilter;
 pub use sinc::LanczosSincFilter;
 pub use triangle::TriangleFilter;
 
+use crate::film::{Film, Spectrum};
+use crate::partition::Partition;
+use crate::registry::{Choice, Entry};
+use acr_parser::{Error, ParamList, Result};
+
 /// A separable or non-separable 2D filter of finite support.
 pub trait FilterKernel: Send + Sync {
     /// Half-widths in x and y (pixels).
@@ -21,43 +26,92 @@ pub trait FilterKernel: Send + Sync {
     fn eval(&self, x: f32, y: f32) -> f32;
 }
 
-/// The built-in kernels as one closed set, so the splatting loop dispatches without a vtable.
-#[derive(Clone, Debug)]
-pub enum Kernel {
-    /// `box`
-    Box(BoxFilter),
-    /// `triangle`
-    Triangle(TriangleFilter),
-    /// `gaussian`
-    Gaussian(GaussianFilter),
-    /// `mitchell`
-    Mitchell(MitchellFilter),
-    /// `sinc`
-    Sinc(LanczosSincFilter),
+/// A reconstruction filter: turns the film into the image.
+pub trait Filter: Send + Sync {
+    /// The plugin's name (`box`, `gaussian`, ...).
+    fn name(&self) -> &'static str;
+
+    /// The kernel the film splats samples with while rendering (box of radius 0.5 for a
+    /// filter that reconstructs from per-pixel statistics instead).
+    fn kernel(&self) -> &dyn FilterKernel;
+
+    /// The image, row-major over the film's (cropped) pixels; `partition` is the sampler's,
+    /// when it has one.
+    fn reconstruct(&self, film: &Film, partition: Option<&Partition>) -> Vec<Spectrum>;
 }
 
-impl FilterKernel for Kernel {
-    #[inline]
-    fn radius(&self) -> (f32, f32) {
-        match self {
-            Kernel::Box(f) => f.radius(),
-            Kernel::Triangle(f) => f.radius(),
-            Kernel::Gaussian(f) => f.radius(),
-            Kernel::Mitchell(f) => f.radius(),
-            Kernel::Sinc(f) => f.radius(),
-        }
+/// pbrt-v3's filters: the film splats each sample with the kernel, and a pixel is the
+/// weighted mean of what reached it.
+#[derive(Clone, Debug)]
+pub struct Splatting<K> {
+    name: &'static str,
+    kernel: K,
+}
+
+impl<K: FilterKernel> Splatting<K> {
+    /// The splatting filter `name` with `kernel`.
+    pub fn new(name: &'static str, kernel: K) -> Self {
+        Self { name, kernel }
+    }
+}
+
+impl<K: FilterKernel> Filter for Splatting<K> {
+    fn name(&self) -> &'static str {
+        self.name
     }
 
-    #[inline]
-    fn eval(&self, x: f32, y: f32) -> f32 {
-        match self {
-            Kernel::Box(f) => f.eval(x, y),
-            Kernel::Triangle(f) => f.eval(x, y),
-            Kernel::Gaussian(f) => f.eval(x, y),
-            Kernel::Mitchell(f) => f.eval(x, y),
-            Kernel::Sinc(f) => f.eval(x, y),
+    fn kernel(&self) -> &dyn FilterKernel {
+        &self.kernel
+    }
+
+    fn reconstruct(&self, film: &Film, _partition: Option<&Partition>) -> Vec<Spectrum> {
+        film.pixels()
+    }
+}
+
+/// Builds a filter from its checked parameters.
+pub type FilterBuild = fn(&Choice) -> Result<Box<dyn Filter>>;
+
+/// Every filter, by name: a new filter is one file and one line here.
+pub static FILTERS: &[Entry<FilterBuild>] = &[
+    boxf::ENTRY,
+    triangle::ENTRY,
+    gaussian::ENTRY,
+    mitchell::ENTRY,
+    sinc::ENTRY,
+];
+
+/// Doc of the `xwidth` parameter every pbrt-v3 filter has.
+pub(crate) const XWIDTH: &str = "half-width of the support in x, in pixels";
+/// Doc of the `ywidth` parameter every pbrt-v3 filter has.
+pub(crate) const YWIDTH: &str = "half-width of the support in y, in pixels";
+
+/// The filter's half-widths (`xwidth`, `ywidth`), each in (0, 64] pixels.
+pub(crate) fn radius(params: &ParamList, default: f64) -> Result<(f32, f32)> {
+    let get = |name: &str| -> Result<f32> {
+        let v = params.float_or(name, default)?;
+        if !(v > 0.0 && v <= 64.0) {
+            if let Some(p) = params.get(name) {
+                return Err(Error::at(
+                    &p.loc,
+                    format!("{name} {v} is out of range (0, 64]"),
+                ));
+            }
+        }
+        Ok(v as f32)
+    };
+    Ok((get("xwidth")?, get("ywidth")?))
+}
+
+/// A float parameter that must be finite.
+pub(crate) fn finite(params: &ParamList, name: &str, default: f64) -> Result<f32> {
+    let v = params.float_or(name, default)?;
+    if !v.is_finite() {
+        if let Some(p) = params.get(name) {
+            return Err(Error::at(&p.loc, format!("{name} must be finite")));
         }
     }
+    Ok(v as f32)
 }
 
 #[cfg(test)]
@@ -82,14 +136,14 @@ mod tests {
 
     #[test]
     fn kernels_are_zero_outside_and_symmetric() {
-        let kernels = [
-            Kernel::Box(BoxFilter::new(0.5, 0.5)),
-            Kernel::Triangle(TriangleFilter::new(2.0, 2.0)),
-            Kernel::Gaussian(GaussianFilter::new(2.0, 2.0, 2.0)),
-            Kernel::Mitchell(MitchellFilter::new(2.0, 2.0, 1.0 / 3.0, 1.0 / 3.0)),
-            Kernel::Sinc(LanczosSincFilter::new(4.0, 4.0, 3.0)),
+        let kernels: [&dyn FilterKernel; 5] = [
+            &BoxFilter::new(0.5, 0.5),
+            &TriangleFilter::new(2.0, 2.0),
+            &GaussianFilter::new(2.0, 2.0, 2.0),
+            &MitchellFilter::new(2.0, 2.0, 1.0 / 3.0, 1.0 / 3.0),
+            &LanczosSincFilter::new(4.0, 4.0, 3.0),
         ];
-        for k in &kernels {
+        for k in kernels {
             let (rx, ry) = k.radius();
             assert_eq!(k.eval(rx * 1.01, 0.0), 0.0);
             assert_eq!(k.eval(0.0, -ry * 1.01), 0.0);

@@ -1,9 +1,20 @@
 //! The film: pbrt-v3's image film. Each sample is splatted into every pixel within the filter's
-//! radius, weighted; a pixel's value is its weighted mean.
+//! radius, weighted; a pixel's value is its weighted mean. Beside the splats it keeps each
+//! pixel's own samples' count, sum and sum of squares, for the spp and variance AOVs and for
+//! filters that reconstruct from per-pixel statistics.
 
-use crate::geometry::{Spectrum, Vec2};
+use crate::filters::FilterKernel;
 use acr_parser::{Error, PluginDesc, Result};
-use acr_plugins::{FilterKernel, Kernel};
+use glam::{Vec2, Vec3};
+
+/// Linear RGB radiance.
+pub type Spectrum = Vec3;
+
+/// Luminance of linear RGB (pbrt's y(): Rec. 709 weights).
+#[inline]
+pub fn luminance(c: Spectrum) -> f32 {
+    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
+}
 
 /// Entries per axis of the filter table (pbrt-v3's filterTableWidth).
 const TABLE_SIZE: usize = 16;
@@ -95,12 +106,64 @@ impl FilmSettings {
     }
 }
 
+/// The samples drawn for one pixel (those whose raster position lies in it), unfiltered.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelStats {
+    /// How many.
+    pub count: u32,
+    /// Sum of their radiance, per channel.
+    pub sum: [f64; 3],
+    /// Sum of their squared radiance, per channel.
+    pub sum_sq: [f64; 3],
+}
+
+impl PixelStats {
+    /// Adds one sample's radiance.
+    #[inline]
+    pub fn add(&mut self, l: Spectrum) {
+        self.count += 1;
+        for (c, v) in [l.x, l.y, l.z].into_iter().enumerate() {
+            let v = f64::from(v);
+            self.sum[c] += v;
+            self.sum_sq[c] += v * v;
+        }
+    }
+
+    /// The mean radiance (zero without samples).
+    pub fn mean(&self) -> Spectrum {
+        if self.count == 0 {
+            return Spectrum::ZERO;
+        }
+        let n = f64::from(self.count);
+        Spectrum::new(
+            (self.sum[0] / n) as f32,
+            (self.sum[1] / n) as f32,
+            (self.sum[2] / n) as f32,
+        )
+    }
+
+    /// The variance of the mean per channel: the unbiased sample variance over the count
+    /// (zero with fewer than two samples, where it cannot be estimated).
+    pub fn variance_of_mean(&self) -> Spectrum {
+        if self.count < 2 {
+            return Spectrum::ZERO;
+        }
+        let n = f64::from(self.count);
+        let v = |c: usize| {
+            let mean = self.sum[c] / n;
+            ((self.sum_sq[c] - n * mean * mean).max(0.0) / (n - 1.0) / n) as f32
+        };
+        Spectrum::new(v(0), v(1), v(2))
+    }
+}
+
 /// Accumulated, filtered samples.
 #[derive(Clone, Debug)]
 pub struct Film {
     settings: FilmSettings,
     splat: Splat,
     sums: Vec<[f64; 4]>,
+    stats: Vec<PixelStats>,
     /// [`Film::add_samples`]'s prepared samples, kept to reuse the allocation.
     prepared: Vec<Prepared>,
 }
@@ -224,7 +287,7 @@ impl Splat {
     /// The radiance after the film's luminance clamp (pbrt-v3's maxsampleluminance).
     #[inline]
     fn clamped(&self, l: Spectrum) -> Spectrum {
-        let lum = crate::spectrum_luminance(l);
+        let lum = luminance(l);
         if lum > self.max_luminance {
             l * (self.max_luminance / lum)
         } else {
@@ -235,7 +298,7 @@ impl Splat {
 
 impl Film {
     /// An empty film.
-    pub fn new(settings: FilmSettings, kernel: Kernel) -> Self {
+    pub fn new(settings: FilmSettings, kernel: &dyn FilterKernel) -> Self {
         let (w, h) = settings.size();
         let (rx, ry) = kernel.radius();
         let mut table = [0.0f32; TABLE_SIZE * TABLE_SIZE];
@@ -249,6 +312,7 @@ impl Film {
         let [cx0, cx1, _, _] = settings.crop;
         Self {
             sums: vec![[0.0; 4]; w as usize * h as usize],
+            stats: vec![PixelStats::default(); w as usize * h as usize],
             splat: Splat {
                 table,
                 radius: (rx, ry),
@@ -276,6 +340,9 @@ impl Film {
         let y1 = ((dy + ry).floor() as i64 + 1).min(cy1 as i64);
         let l = self.splat.clamped(l);
         let w = self.settings.size().0 as usize;
+        if let Some(i) = self.pixel_index(p) {
+            self.stats[i].add(l);
+        }
         for y in y0..y1 {
             let start = (y - cy0 as i64) as usize * w;
             self.splat.row(&mut self.sums[start..start + w], y, p, l);
@@ -294,6 +361,7 @@ impl Film {
         let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
             return;
         };
+        self.add_stats(samples);
         let cy0 = self.settings.crop[2] as i64;
         let ry = self.splat.radius.1;
         // Sorted by whole rows only: the extreme positions are bounded by the rows' edges.
@@ -345,9 +413,44 @@ impl Film {
             });
     }
 
-    /// The image: each pixel's weighted mean times the film scale, row-major, top row first.
+    /// Adds row-sorted samples to the statistics of the pixels they lie in, rows in parallel.
+    fn add_stats(&mut self, samples: &[(Vec2, Spectrum)]) {
+        use rayon::prelude::*;
+        let [cx0, cx1, cy0, _] = self.settings.crop;
+        let w = (cx1 - cx0) as usize;
+        let splat = &self.splat;
+        self.stats
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(row_index, row)| {
+                let y = (row_index as u32 + cy0) as f32;
+                let from = samples.partition_point(|(p, _)| p.y.floor() < y);
+                let to = samples.partition_point(|(p, _)| p.y.floor() <= y);
+                for &(p, l) in &samples[from..to] {
+                    let x = p.x.floor();
+                    if x >= cx0 as f32 && x < cx1 as f32 {
+                        row[(x - cx0 as f32) as usize].add(splat.clamped(l));
+                    }
+                }
+            });
+    }
+
+    /// The index into the cropped image of the pixel holding raster position `p`, if any.
+    fn pixel_index(&self, p: Vec2) -> Option<usize> {
+        let [cx0, cx1, cy0, cy1] = self.settings.crop;
+        let (x, y) = (p.x.floor(), p.y.floor());
+        let inside = x >= cx0 as f32 && x < cx1 as f32 && y >= cy0 as f32 && y < cy1 as f32;
+        inside.then(|| (y as u32 - cy0) as usize * (cx1 - cx0) as usize + (x as u32 - cx0) as usize)
+    }
+
+    /// Each pixel's own samples, row-major over the cropped image.
+    pub fn pixel_stats(&self) -> &[PixelStats] {
+        &self.stats
+    }
+
+    /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
+    /// `scale` is applied on output, not here).
     pub fn pixels(&self) -> Vec<Spectrum> {
-        let scale = self.settings.scale;
         self.sums
             .iter()
             .map(|s| {
@@ -360,7 +463,6 @@ impl Film {
                         (s[2] * inv) as f32,
                     )
                     .max(Spectrum::ZERO)
-                        * scale
                 } else {
                     Spectrum::ZERO
                 }
@@ -372,13 +474,13 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use acr_plugins::filters::{BoxFilter, GaussianFilter};
+    use crate::filters::{BoxFilter, GaussianFilter};
 
     #[test]
     fn box_filter_averages_samples_in_the_pixel() {
         let mut f = Film::new(
             FilmSettings::with_resolution(2, 1),
-            Kernel::Box(BoxFilter::new(0.5, 0.5)),
+            &BoxFilter::new(0.5, 0.5),
         );
         f.add_sample(Vec2::new(0.25, 0.5), Spectrum::splat(1.0));
         f.add_sample(Vec2::new(0.75, 0.5), Spectrum::splat(3.0));
@@ -386,16 +488,22 @@ mod tests {
         let p = f.pixels();
         assert_eq!(p[0], Spectrum::splat(2.0));
         assert_eq!(p[1], Spectrum::splat(5.0));
+        let st = f.pixel_stats();
+        assert_eq!((st[0].count, st[1].count), (2, 1));
+        assert_eq!(st[0].mean(), Spectrum::splat(2.0));
+        // Samples 1 and 3: sample variance 2, variance of the mean 1.
+        assert_eq!(st[0].variance_of_mean(), Spectrum::splat(1.0));
+        assert_eq!(st[1].variance_of_mean(), Spectrum::ZERO);
     }
 
     #[test]
     fn batch_adding_equals_one_by_one() {
-        use acr_plugins::filters::MitchellFilter;
-        let kernel = Kernel::Mitchell(MitchellFilter::new(2.0, 1.5, 1.0 / 3.0, 1.0 / 3.0));
+        use crate::filters::MitchellFilter;
+        let kernel = MitchellFilter::new(2.0, 1.5, 1.0 / 3.0, 1.0 / 3.0);
         let mut s = FilmSettings::with_resolution(9, 7);
         s.crop = [1, 8, 1, 6];
-        let mut one = Film::new(s.clone(), kernel.clone());
-        let mut batch = Film::new(s, kernel);
+        let mut one = Film::new(s.clone(), &kernel);
+        let mut batch = Film::new(s, &kernel);
         // Row-sorted samples, several per pixel, with varied values.
         let mut samples = Vec::new();
         for py in 0..7u32 {
@@ -416,13 +524,15 @@ mod tests {
         batch.add_samples(&samples[..100]);
         batch.add_samples(&samples[100..]);
         assert_eq!(one.pixels(), batch.pixels());
+        assert_eq!(one.pixel_stats(), batch.pixel_stats());
+        assert_eq!(batch.pixel_stats()[0].count, 3);
     }
 
     #[test]
     fn wide_filter_reaches_neighbours_and_crop_limits_output() {
         let mut s = FilmSettings::with_resolution(4, 4);
         s.crop = [1, 3, 1, 3];
-        let mut f = Film::new(s, Kernel::Gaussian(GaussianFilter::new(2.0, 2.0, 2.0)));
+        let mut f = Film::new(s, &GaussianFilter::new(2.0, 2.0, 2.0));
         f.add_sample(Vec2::new(1.5, 1.5), Spectrum::new(1.0, 2.0, 3.0));
         let p = f.pixels();
         assert_eq!(p.len(), 4);

@@ -1,0 +1,527 @@
+//! Samplers: batches of points in the rendering space (`space.rs`), whole pixels at a time in
+//! row-major order. Every sampler is deterministic in (space, spp, seed) and keeps no global
+//! state, so an image does not depend on the thread count. A new sampler is one file here.
+
+mod halton;
+mod random;
+mod sobol;
+mod stratified;
+
+pub use halton::HaltonSampler;
+pub use random::RandomSampler;
+pub use sobol::{SobolSampler, SOBOL_DIMS_USED, SOBOL_SAMPLES};
+pub use stratified::StratifiedSampler;
+
+use crate::partition::Partition;
+use crate::registry::{Choice, Entry};
+use crate::space::{RenderingSpace, SamplePoint};
+use acr_parser::{Error, ParamList, Result};
+use std::ops::Range;
+
+/// Samples per batch: enough to keep every thread busy, few enough to report progress often.
+pub const BATCH_SAMPLES: u64 = 1 << 15;
+
+/// Largest accepted samples per pixel.
+pub const MAX_SPP: u32 = 1 << 20;
+
+/// A source of sample points over the rendering space.
+pub trait Sampler: Send {
+    /// The plugin's name (`random`, `stratified`, ...).
+    fn name(&self) -> &'static str;
+
+    /// The samples per pixel it will give unless halted.
+    fn spp(&self) -> u32;
+
+    /// Clears `out` and fills it with the next batch, row-major by pixel, each pixel's
+    /// samples together. Returns false (with `out` empty) once the budget is spent.
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool;
+
+    /// The radiance of each point of `batch`, in order; adaptive samplers learn from it.
+    fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        let _ = (batch, radiance);
+    }
+
+    /// Asks the sampler to stop early (a time limit): it ends its current pass, so that every
+    /// pixel has as many samples as the others (at least one pass), then gives no more.
+    fn halt(&mut self);
+
+    /// The sampler's clusters, for the reconstruction, when it has any.
+    fn partition(&self) -> Option<&Partition> {
+        None
+    }
+}
+
+/// What every sampler is built for: the space, the command line's `--spp` and the seed.
+#[derive(Clone, Copy, Debug)]
+pub struct SamplerSetup {
+    /// The part of the rendering space to sample.
+    pub space: RenderingSpace,
+    /// Samples per pixel from the command line, overriding the sampler's own parameter.
+    pub spp: Option<u32>,
+    /// Seed of every random decision.
+    pub seed: u64,
+}
+
+/// Builds a sampler from its checked parameters.
+pub type SamplerBuild = fn(&Choice, &SamplerSetup) -> Result<Box<dyn Sampler>>;
+
+/// Every sampler, by name: a new sampler is one file and one line here.
+pub static SAMPLERS: &[Entry<SamplerBuild>] = &[
+    random::ENTRY,
+    stratified::ENTRY,
+    halton::ENTRY,
+    sobol::ENTRY,
+];
+
+/// The `pixelsamples` parameter, or the command line's `--spp`, checked to lie in 1..=MAX_SPP.
+pub(crate) fn pixel_samples(params: &ParamList, setup: &SamplerSetup) -> Result<u32> {
+    let v = params.int_or("pixelsamples", 16)?;
+    if let Some(spp) = setup.spp {
+        return Ok(spp.clamp(1, MAX_SPP));
+    }
+    check_count(params, "pixelsamples", i64::from(v))
+}
+
+/// A positive count parameter within 1..=MAX_SPP, or an error at its location.
+pub(crate) fn check_count(params: &ParamList, name: &str, v: i64) -> Result<u32> {
+    if v < 1 || v > i64::from(MAX_SPP) {
+        if let Some(p) = params.get(name) {
+            return Err(Error::at(
+                &p.loc,
+                format!("{name} {v} is out of range (1 to {MAX_SPP})"),
+            ));
+        }
+    }
+    Ok(v.clamp(1, i64::from(MAX_SPP)) as u32)
+}
+
+/// Doc of `pixelsamples`.
+pub(crate) const PIXELSAMPLES: &str = "samples per pixel (--spp overrides)";
+
+/// Walks a space's pixels in passes: each pass gives every pixel the next few sample indices
+/// (as many as keep a pass near a batch), in batches of whole pixels, row-major. Between
+/// passes every pixel has the same count, which is where a halted sampler stops.
+#[derive(Clone, Debug)]
+pub(crate) struct PixelCursor {
+    space: RenderingSpace,
+    spp: u32,
+    pass_len: u32,
+    pass_start: u32,
+    next_pixel: u64,
+    halted: bool,
+}
+
+impl PixelCursor {
+    /// A cursor at the first pixel, for `spp` samples per pixel.
+    pub(crate) fn new(space: RenderingSpace, spp: u32) -> Self {
+        let pixels = space.pixels().max(1);
+        Self {
+            space,
+            spp,
+            pass_len: (BATCH_SAMPLES / pixels).clamp(1, u64::from(spp.max(1))) as u32,
+            pass_start: 0,
+            next_pixel: 0,
+            halted: false,
+        }
+    }
+
+    /// The space walked.
+    pub(crate) fn space(&self) -> &RenderingSpace {
+        &self.space
+    }
+
+    /// The next batch: row-major pixel indices and the sample indices each of them gets, or
+    /// None when every pixel is done.
+    pub(crate) fn next(&mut self) -> Option<(Range<u64>, Range<u32>)> {
+        let total = self.space.pixels();
+        if total == 0 || self.pass_start >= self.spp {
+            return None;
+        }
+        let n = self.pass_len.min(self.spp - self.pass_start);
+        // A pixel with more than a batch's samples forms a batch alone.
+        let per_batch = (BATCH_SAMPLES / u64::from(n)).max(1);
+        let end = (self.next_pixel + per_batch).min(total);
+        let batch = (self.next_pixel..end, self.pass_start..self.pass_start + n);
+        self.next_pixel = end;
+        if end == total {
+            self.next_pixel = 0;
+            self.pass_start = if self.halted {
+                self.spp
+            } else {
+                self.pass_start + n
+            };
+        }
+        Some(batch)
+    }
+
+    /// Ends the walk after the current pass (after the first pass, if none is complete yet).
+    pub(crate) fn halt(&mut self) {
+        self.halted = true;
+        if self.next_pixel == 0 && self.pass_start > 0 {
+            self.pass_start = self.spp;
+        }
+    }
+}
+
+/// A hash of 64 bits to 64 bits (SplitMix64's finaliser).
+#[inline]
+pub(crate) fn mix64(mut x: u64) -> u64 {
+    x ^= x >> 30;
+    x = x.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x ^= x >> 27;
+    x = x.wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// A key for `pixel` under `seed`, salted per sampler so that samplers do not share streams
+/// with each other or with the integrator's per-sample stream.
+#[inline]
+pub(crate) fn pixel_key(pixel: [u32; 2], seed: u64, salt: u64) -> u64 {
+    let p = (u64::from(pixel[1]) << 32) | u64::from(pixel[0]);
+    mix64(p ^ mix64(seed ^ mix64(salt)))
+}
+
+/// PCG32 (O'Neill): a small, fast generator with 2^64 period per stream.
+#[derive(Clone, Debug)]
+pub(crate) struct Pcg32 {
+    state: u64,
+    inc: u64,
+}
+
+impl Pcg32 {
+    /// A generator for `(seed, stream)`.
+    pub(crate) fn new(seed: u64, stream: u64) -> Self {
+        let mut r = Self {
+            state: 0,
+            inc: (stream << 1) | 1,
+        };
+        r.next_u32();
+        r.state = r.state.wrapping_add(seed);
+        r.next_u32();
+        r
+    }
+
+    /// The next 32 random bits.
+    #[inline]
+    pub(crate) fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(self.inc);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+
+    /// A uniform float in [0, 1) (24 random bits, so it never rounds to 1).
+    #[inline]
+    pub(crate) fn next_f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+
+    /// A uniform integer in [0, n) (multiply-shift; its bias of n / 2^32 is negligible here).
+    #[inline]
+    pub(crate) fn below(&mut self, n: u32) -> u32 {
+        ((u64::from(self.next_u32()) * u64::from(n)) >> 32) as u32
+    }
+
+    /// Shuffles `v` in place (Fisher-Yates).
+    pub(crate) fn shuffle<T>(&mut self, v: &mut [T]) {
+        for i in (1..v.len()).rev() {
+            let j = self.below(i as u32 + 1) as usize;
+            v.swap(i, j);
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::space::Dims;
+
+    /// Every combination of active dims.
+    pub(crate) const ALL_DIMS: [Dims; 4] = [
+        Dims {
+            time: false,
+            lens: false,
+        },
+        Dims {
+            time: true,
+            lens: false,
+        },
+        Dims {
+            time: false,
+            lens: true,
+        },
+        Dims {
+            time: true,
+            lens: true,
+        },
+    ];
+
+    /// A space of `w` x `h` pixels from (x0, y0).
+    pub(crate) fn space(x0: u32, y0: u32, w: u32, h: u32, dims: Dims) -> RenderingSpace {
+        RenderingSpace {
+            x0,
+            x1: x0 + w,
+            y0,
+            y1: y0 + h,
+            dims,
+        }
+    }
+
+    /// Every sampler at `spp` (stratified as sqrt x sqrt when spp is a square, else spp x 1).
+    pub(crate) fn all(s: RenderingSpace, spp: u32, seed: u64) -> Vec<Box<dyn Sampler>> {
+        let r = (spp as f64).sqrt() as u32;
+        let (xs, ys) = if r * r == spp { (r, r) } else { (spp, 1) };
+        vec![
+            Box::new(RandomSampler::new(s, spp, seed)) as Box<dyn Sampler>,
+            Box::new(StratifiedSampler::new(s, xs, ys, true, seed)),
+            Box::new(StratifiedSampler::new(s, xs, ys, false, seed)),
+            Box::new(HaltonSampler::new(s, spp, seed)),
+            Box::new(SobolSampler::new(s, spp, seed)),
+        ]
+    }
+
+    /// Every batch a sampler gives, in order.
+    pub(crate) fn batches(s: &mut dyn Sampler) -> Vec<Vec<SamplePoint>> {
+        let mut v = Vec::new();
+        let mut b = vec![SamplePoint {
+            pixel: [9, 9],
+            index: 9,
+            film: [0.0; 2],
+            time: 0.0,
+            lens: [0.0; 2],
+        }];
+        while s.next_batch(&mut b) {
+            v.push(b.clone());
+        }
+        assert!(b.is_empty(), "{}: the last call leaves out empty", s.name());
+        // Once spent, a sampler stays spent.
+        assert!(!s.next_batch(&mut b));
+        v
+    }
+
+    /// The points of `batches` grouped by pixel (row-major) and sorted by index.
+    pub(crate) fn by_pixel(sp: &RenderingSpace, bs: &[Vec<SamplePoint>]) -> Vec<SamplePoint> {
+        let mut all: Vec<SamplePoint> = bs.iter().flatten().copied().collect();
+        let key = |q: &SamplePoint| {
+            (
+                u64::from(q.pixel[1] - sp.y0) * u64::from(sp.width())
+                    + u64::from(q.pixel[0] - sp.x0),
+                q.index,
+            )
+        };
+        all.sort_by_key(key);
+        all
+    }
+
+    /// Asserts the contract every sampler keeps on `sp` at `spp`.
+    fn check_contract(s: &mut dyn Sampler, sp: &RenderingSpace, spp: u32) {
+        let name = s.name();
+        assert_eq!(s.spp(), spp, "{name}");
+        let bs = batches(s);
+        for b in &bs {
+            assert!(!b.is_empty());
+            assert!(
+                b.len() as u64 <= BATCH_SAMPLES.max(u64::from(spp)),
+                "{name}"
+            );
+            // Row-major pixels, each with one run of consecutive indices, the same for all.
+            let run = b.iter().take_while(|q| q.pixel == b[0].pixel).count();
+            assert_eq!(b.len() % run, 0, "{name}");
+            for (k, chunk) in b.chunks(run).enumerate() {
+                assert!(chunk.iter().all(|q| q.pixel == chunk[0].pixel), "{name}");
+                for (i, q) in chunk.iter().enumerate() {
+                    assert_eq!(q.index, b[i].index, "{name}");
+                    assert_eq!(q.index, chunk[0].index + i as u32, "{name}");
+                }
+                if k > 0 {
+                    let prev = b[(k - 1) * run].pixel;
+                    assert!((prev[1], prev[0]) < (chunk[0].pixel[1], chunk[0].pixel[0]));
+                }
+            }
+        }
+        let all = by_pixel(sp, &bs);
+        assert_eq!(all.len() as u64, sp.pixels() * u64::from(spp), "{name}");
+        // Each pixel's indices 0..spp exactly once.
+        for (k, chunk) in all.chunks(spp as usize).enumerate() {
+            let p = sp.pixel(k as u64);
+            for (i, q) in chunk.iter().enumerate() {
+                assert_eq!(q.pixel, p, "{name}");
+                assert_eq!(q.index, i as u32, "{name}");
+            }
+        }
+        for q in &all {
+            for a in 0..2 {
+                let f = f64::from(q.film[a]);
+                let p = f64::from(q.pixel[a]);
+                assert!(
+                    f >= p && f < p + 1.0,
+                    "{name}: film {:?} in {:?}",
+                    q.film,
+                    q.pixel
+                );
+            }
+            if sp.dims.time {
+                assert!((0.0..1.0).contains(&q.time), "{name}: t {}", q.time);
+            } else {
+                assert_eq!(q.time, 0.5, "{name}");
+            }
+            if sp.dims.lens {
+                assert!(q.lens.iter().all(|l| (0.0..1.0).contains(l)), "{name}");
+            } else {
+                assert_eq!(q.lens, [0.5, 0.5], "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_sampler_keeps_the_contract() {
+        for dims in ALL_DIMS {
+            // Odd sizes, a far-off origin (rounding), a budget spanning several batches.
+            for (sp, spp) in [
+                (space(0, 0, 7, 5, dims), 4),
+                (space(4090, 1020, 9, 6, dims), 9),
+                (space(2, 3, 64, 40, dims), 16),
+            ] {
+                for mut s in all(sp, spp, 7) {
+                    check_contract(s.as_mut(), &sp, spp);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn batches_are_about_batch_samples() {
+        let sp = space(0, 0, 100, 30, ALL_DIMS[3]);
+        let mut s = RandomSampler::new(sp, 16, 1);
+        // Passes of 10 and 6 samples per pixel over all 3000 pixels.
+        let bs = batches(&mut s);
+        assert_eq!(
+            bs.iter().map(Vec::len).collect::<Vec<_>>(),
+            [30_000, 18_000]
+        );
+        // More samples per pixel than a batch holds: passes of half a batch per pixel.
+        let sp = space(0, 0, 2, 1, ALL_DIMS[0]);
+        let mut s = RandomSampler::new(sp, 40_000, 1);
+        assert_eq!(
+            batches(&mut s).iter().map(Vec::len).collect::<Vec<_>>(),
+            [32_768, 32_768, 14_464]
+        );
+        // A pixel alone over a batch: one pixel per batch.
+        let sp = space(0, 0, 1, 1, ALL_DIMS[0]);
+        let mut s = RandomSampler::new(sp, 40_000, 1);
+        assert_eq!(
+            batches(&mut s).iter().map(Vec::len).collect::<Vec<_>>(),
+            [32_768, 7_232]
+        );
+        // No pixels, no batch.
+        let mut s = SobolSampler::new(space(0, 0, 0, 4, ALL_DIMS[0]), 4, 1);
+        assert!(batches(&mut s).is_empty());
+    }
+
+    #[test]
+    fn halting_ends_the_pass_so_every_pixel_has_as_many_samples() {
+        let sp = space(0, 0, 400, 100, ALL_DIMS[3]);
+        for mut s in all(sp, 16, 2) {
+            let mut b = Vec::new();
+            // Halt during the first pass: that pass completes and nothing follows.
+            assert!(s.next_batch(&mut b));
+            let mut got = b.clone();
+            s.halt();
+            while s.next_batch(&mut b) {
+                got.extend_from_slice(&b);
+            }
+            assert_eq!(got.len(), 40_000, "{}", s.name());
+            let mut count = vec![0u32; 40_000];
+            for q in &got {
+                count[(q.pixel[1] * 400 + q.pixel[0]) as usize] += 1;
+            }
+            assert!(count.iter().all(|&c| c == 1), "{}", s.name());
+        }
+        // Halted between passes: stops at once.
+        let mut s = SobolSampler::new(space(0, 0, 300, 100, ALL_DIMS[0]), 16, 2);
+        let mut b = Vec::new();
+        assert!(s.next_batch(&mut b));
+        s.halt();
+        assert!(!s.next_batch(&mut b));
+    }
+
+    #[test]
+    fn same_seed_same_points_other_seed_other_points() {
+        for dims in ALL_DIMS {
+            let sp = space(5, 6, 11, 7, dims);
+            let a: Vec<_> = all(sp, 16, 3)
+                .iter_mut()
+                .map(|s| batches(s.as_mut()))
+                .collect();
+            let b: Vec<_> = all(sp, 16, 3)
+                .iter_mut()
+                .map(|s| batches(s.as_mut()))
+                .collect();
+            let c: Vec<_> = all(sp, 16, 4)
+                .iter_mut()
+                .map(|s| batches(s.as_mut()))
+                .collect();
+            assert_eq!(a, b);
+            for k in 0..a.len() {
+                let (x, y): (Vec<_>, Vec<_>) = (a[k].concat(), c[k].concat());
+                // The unjittered stratified sampler differs only in its shuffles.
+                let differ = x.iter().zip(&y).filter(|(p, q)| p != q).count();
+                assert!(differ * 2 > x.len(), "sampler {k}: {differ} of {}", x.len());
+            }
+        }
+    }
+
+    /// The exact star discrepancy of points in [0, 1): sup over x of |#{v < x} / n - x|.
+    pub(crate) fn star_discrepancy(vals: &[f64]) -> f64 {
+        let mut v = vals.to_vec();
+        v.sort_by(f64::total_cmp);
+        let n = v.len() as f64;
+        v.iter()
+            .enumerate()
+            .map(|(i, &x)| (x - i as f64 / n).max((i + 1) as f64 / n - x))
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn star_discrepancy_is_exact_on_known_sets() {
+        assert_eq!(star_discrepancy(&[0.5]), 0.5);
+        // Centred strata: 1 / (2n).
+        let c: Vec<f64> = (0..8).map(|i| (i as f64 + 0.5) / 8.0).collect();
+        assert!((star_discrepancy(&c) - 1.0 / 16.0).abs() < 1e-12);
+    }
+
+    /// Generation speed, one sampler at a time (`cargo test -p acr-plugins --release --
+    /// --ignored --nocapture throughput`): the render loop generates batches sequentially.
+    #[test]
+    #[ignore]
+    fn throughput() {
+        for dims in [ALL_DIMS[0], ALL_DIMS[3]] {
+            let sp = space(0, 0, 512, 512, dims);
+            for mut s in all(sp, 16, 1) {
+                let mut b = Vec::new();
+                let t = std::time::Instant::now();
+                let mut n = 0;
+                while s.next_batch(&mut b) {
+                    n += b.len();
+                }
+                let ns = t.elapsed().as_nanos() as f64 / n as f64;
+                eprintln!("{:>10} dims {:?}: {ns:.1} ns/point", s.name(), dims.names());
+            }
+        }
+    }
+
+    #[test]
+    fn pixels_differ() {
+        // Neighbouring pixels do not repeat each other's offsets (per-pixel scrambling).
+        let sp = space(0, 0, 2, 1, ALL_DIMS[3]);
+        for mut s in all(sp, 16, 5) {
+            let b = &batches(s.as_mut())[0];
+            let off = |q: &SamplePoint| [q.film[0].fract(), q.film[1].fract(), q.time, q.lens[0]];
+            let same = (0..16).filter(|&i| off(&b[i]) == off(&b[16 + i])).count();
+            assert!(same < 4, "{}: {same}", s.name());
+        }
+    }
+}

@@ -1,0 +1,198 @@
+//! `sobol`: Owen-scrambled Sobol points per pixel (as pbrt-v4's padded Sobol sampler), through
+//! `sobol_burley`: dims 0, 1 the film offset, 2 time, 3, 4 the lens, scrambled from a hash of
+//! (pixel, seed). The first 2^k points of a pixel form a (0, k, 1)-net in each dim, so spp = 16
+//! puts one point in each 1/16 of every 1D projection.
+
+use super::{pixel_key, Pcg32, PixelCursor, Sampler};
+use super::{SamplerBuild, SamplerSetup};
+use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::space::{in_pixel, RenderingSpace, SamplePoint};
+use acr_parser::{ParamType, Result};
+
+/// Salt of this sampler's per-pixel keys.
+const SALT: u64 = 0x736f_626c;
+
+/// Samples per pixel that the Sobol sequence covers (sobol_burley's limit); later samples of a
+/// pixel come from a hashed random stream.
+pub const SOBOL_SAMPLES: u32 = 1 << 16;
+
+/// The integrator's per-sample stream must start past these Sobol dims, or its first
+/// dimensions would repeat the sampler's.
+pub const SOBOL_DIMS_USED: u32 = 5;
+
+/// Owen-scrambled Sobol points per pixel.
+#[derive(Clone, Debug)]
+pub struct SobolSampler {
+    cursor: PixelCursor,
+    spp: u32,
+    seed: u64,
+}
+
+impl SobolSampler {
+    /// `spp` samples in each pixel of `space`, scrambled from `seed`.
+    pub fn new(space: RenderingSpace, spp: u32, seed: u64) -> Self {
+        Self {
+            cursor: PixelCursor::new(space, spp),
+            spp,
+            seed,
+        }
+    }
+
+    fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
+        let dims = self.cursor.space().dims;
+        let key = pixel_key(p, self.seed, SALT);
+        let scramble = (key ^ (key >> 32)) as u32;
+        for index in indices {
+            let (off, time, lens) = if index < SOBOL_SAMPLES {
+                // One SIMD call gives dims 0-3; v (dim 4) only when the lens is on.
+                let s = sobol_burley::sample_4d(index, 0, scramble);
+                let lens = if dims.lens {
+                    [s[3], sobol_burley::sample(index, 4, scramble)]
+                } else {
+                    [0.5; 2]
+                };
+                ([s[0], s[1]], if dims.time { s[2] } else { 0.5 }, lens)
+            } else {
+                let mut rng = Pcg32::new(
+                    super::mix64(key ^ super::mix64(u64::from(index))),
+                    u64::from(index),
+                );
+                let off = [rng.next_f32(), rng.next_f32()];
+                let time = if dims.time { rng.next_f32() } else { 0.5 };
+                let lens = if dims.lens {
+                    [rng.next_f32(), rng.next_f32()]
+                } else {
+                    [0.5; 2]
+                };
+                (off, time, lens)
+            };
+            out.push(SamplePoint {
+                pixel: p,
+                index,
+                film: [in_pixel(p[0], off[0]), in_pixel(p[1], off[1])],
+                time,
+                lens,
+            });
+        }
+    }
+}
+
+impl Sampler for SobolSampler {
+    fn name(&self) -> &'static str {
+        "sobol"
+    }
+
+    fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+        out.clear();
+        let Some((pixels, indices)) = self.cursor.next() else {
+            return false;
+        };
+        for i in pixels {
+            let p = self.cursor.space().pixel(i);
+            self.pixel(p, indices.clone(), out);
+        }
+        true
+    }
+
+    fn halt(&mut self) {
+        self.cursor.halt();
+    }
+}
+
+/// The registry's entry.
+pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
+    info: PluginInfo {
+        kind: Kind::Sampler,
+        name: "sobol",
+        doc: "Owen-scrambled Sobol points per pixel (pbrt-v4 padded Sobol, via sobol_burley)",
+        params: &[ParamSpec::new(
+            "pixelsamples",
+            ParamType::Integer,
+            "16",
+            super::PIXELSAMPLES,
+        )],
+    },
+    build,
+};
+
+fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
+    let spp = super::pixel_samples(&c.params, setup)?;
+    Ok(Box::new(SobolSampler::new(setup.space, spp, setup.seed)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{batches, space, star_discrepancy, ALL_DIMS};
+    use super::*;
+
+    /// Counts per interval of width 1/n of each 1D projection of one pixel's points.
+    fn projections(px: &[SamplePoint], n: usize) -> [Vec<u32>; 5] {
+        let mut c: [Vec<u32>; 5] = std::array::from_fn(|_| vec![0; n]);
+        for q in px {
+            let v = [
+                f64::from(q.film[0]) - f64::from(q.pixel[0]),
+                f64::from(q.film[1]) - f64::from(q.pixel[1]),
+                f64::from(q.time),
+                f64::from(q.lens[0]),
+                f64::from(q.lens[1]),
+            ];
+            for d in 0..5 {
+                c[d][(v[d] * n as f64).floor() as usize] += 1;
+            }
+        }
+        c
+    }
+
+    #[test]
+    fn one_point_per_interval_in_each_projection() {
+        for spp in [16, 64] {
+            let mut worst = 0.0f64;
+            let sp = space(0, 0, 4, 4, ALL_DIMS[3]);
+            let mut s = SobolSampler::new(sp, spp, 8);
+            for px in batches(&mut s).concat().chunks(spp as usize) {
+                for (d, c) in projections(px, spp as usize).iter().enumerate() {
+                    assert!(c.iter().all(|&k| k == 1), "spp {spp} dim {d}: {c:?}");
+                }
+                // One point per 1/n interval bounds the star discrepancy by 1/n: [0, x) with
+                // x in [k/n, (k+1)/n) holds k or k + 1 points against n x in [k, k + 1).
+                let v: [Vec<f64>; 5] = std::array::from_fn(|d| {
+                    px.iter()
+                        .map(|q| match d {
+                            0 => f64::from(q.film[0]) - f64::from(q.pixel[0]),
+                            1 => f64::from(q.film[1]) - f64::from(q.pixel[1]),
+                            2 => f64::from(q.time),
+                            3 => f64::from(q.lens[0]),
+                            _ => f64::from(q.lens[1]),
+                        })
+                        .collect()
+                });
+                for vals in &v {
+                    let d = star_discrepancy(vals);
+                    assert!(d <= 1.0 / f64::from(spp) + 1e-9);
+                    worst = worst.max(d);
+                }
+            }
+            eprintln!("sobol spp {spp}: worst 1D star discrepancy {worst:.4} (1/spp bound)");
+        }
+    }
+
+    #[test]
+    fn past_the_sobol_limit_points_stay_in_range() {
+        let sp = space(3, 4, 1, 1, ALL_DIMS[3]);
+        let mut s = SobolSampler::new(sp, SOBOL_SAMPLES + 300, 1);
+        let pts = batches(&mut s).concat();
+        assert_eq!(pts.len(), SOBOL_SAMPLES as usize + 300);
+        let late = &pts[SOBOL_SAMPLES as usize..];
+        assert!(late.iter().all(|q| (0.0..1.0).contains(&q.time)
+            && q.lens.iter().all(|l| (0.0..1.0).contains(l))
+            && q.film[0] >= 3.0
+            && q.film[0] < 4.0));
+        // Random, not a repeat of the first points.
+        assert_ne!(late[0].film, pts[0].film);
+        assert_ne!(late[0].time, late[1].time);
+    }
+}

@@ -1,0 +1,192 @@
+//! Arbitrary output variables (`--aov NAME=FILE`): per-pixel images beside the render. `spp` is
+//! the number of samples each pixel received, `variance` the variance of each pixel's mean.
+//! An `.exr` (or `.pfm`) holds the values themselves; a `.png` a false-colour picture scaled
+//! by the largest value, which is written into the PNG (a tEXt chunk) and printed.
+
+use crate::geometry::Spectrum;
+use crate::image_io::{write_image, RgbImage};
+use acr_plugins::PixelStats;
+use std::path::{Path, PathBuf};
+
+/// The AOVs acr writes.
+pub const AOV_NAMES: &[&str] = &["spp", "variance"];
+
+/// One requested AOV.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AovRequest {
+    /// Which (`spp`, `variance`).
+    pub name: String,
+    /// Where to write it.
+    pub path: PathBuf,
+}
+
+/// Parses `NAME=FILE[,NAME=FILE...]` as `--aov` takes it.
+pub fn parse_aovs(arg: &str) -> Result<Vec<AovRequest>, String> {
+    arg.split(',')
+        .map(|part| {
+            let (name, file) = part
+                .split_once('=')
+                .ok_or_else(|| format!("--aov \"{part}\" is not NAME=FILE (e.g. spp=spp.png)"))?;
+            let name = name.trim();
+            if !AOV_NAMES.contains(&name) {
+                let hint = acr_parser::closest(name, AOV_NAMES.iter().copied())
+                    .map_or(String::new(), |k| format!(" (did you mean \"{k}\"?)"));
+                return Err(format!(
+                    "--aov: unknown AOV \"{name}\"{hint}; known: {}",
+                    AOV_NAMES.join(", ")
+                ));
+            }
+            if file.is_empty() {
+                return Err(format!("--aov {name}: the file name is empty"));
+            }
+            Ok(AovRequest {
+                name: name.to_owned(),
+                path: PathBuf::from(file),
+            })
+        })
+        .collect()
+}
+
+/// The per-pixel values of AOV `name` (one value per channel for `variance`).
+pub fn aov_values(name: &str, stats: &[PixelStats]) -> Vec<Spectrum> {
+    match name {
+        "spp" => stats
+            .iter()
+            .map(|s| Spectrum::splat(s.count as f32))
+            .collect(),
+        _ => stats.iter().map(PixelStats::variance_of_mean).collect(),
+    }
+}
+
+/// Writes AOV `name` of a `width` x `height` film; returns a line saying what was written
+/// (with the false-colour scale for a PNG).
+pub fn write_aov(
+    req: &AovRequest,
+    width: usize,
+    height: usize,
+    stats: &[PixelStats],
+) -> Result<String, String> {
+    let values = aov_values(&req.name, stats);
+    let ext = req
+        .path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext != "png" {
+        write_image(
+            &req.path,
+            &RgbImage {
+                width,
+                height,
+                pixels: values,
+            },
+        )
+        .map_err(|e| format!("{}: {e}", req.path.display()))?;
+        return Ok(format!("{} AOV -> {}", req.name, req.path.display()));
+    }
+    // A scalar per pixel: the count, or the luminance of the variance.
+    let scalar: Vec<f32> = values
+        .iter()
+        .map(|v| {
+            if req.name == "spp" {
+                v.x
+            } else {
+                crate::spectrum_luminance(*v)
+            }
+        })
+        .collect();
+    let max = scalar.iter().copied().fold(0.0f32, f32::max);
+    let unit = if req.name == "spp" {
+        "samples per pixel"
+    } else {
+        "variance of the pixel mean (luminance)"
+    };
+    let scale = format!("false colour from black (0) to white ({max} {unit})");
+    write_false_colour(&req.path, width, height, &scalar, max, &scale)
+        .map_err(|e| format!("{}: {e}", req.path.display()))?;
+    Ok(format!(
+        "{} AOV -> {}: {scale}",
+        req.name,
+        req.path.display()
+    ))
+}
+
+/// The false-colour map: black, blue, magenta, orange, yellow, white (like "inferno"), at
+/// `t` in [0, 1].
+pub fn false_colour(t: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 6] = [
+        [0.0, 0.0, 0.0],
+        [0.12, 0.05, 0.45],
+        [0.55, 0.1, 0.5],
+        [0.9, 0.35, 0.1],
+        [0.98, 0.8, 0.15],
+        [1.0, 1.0, 1.0],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (STOPS.len() - 1) as f32;
+    let i = (x as usize).min(STOPS.len() - 2);
+    let f = x - i as f32;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    std::array::from_fn(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0 + 0.5) as u8)
+}
+
+fn write_false_colour(
+    path: &Path,
+    width: usize,
+    height: usize,
+    values: &[f32],
+    max: f32,
+    scale: &str,
+) -> Result<(), String> {
+    let mut bytes = Vec::with_capacity(3 * values.len());
+    for &v in values {
+        let t = if max > 0.0 { v / max } else { 0.0 };
+        bytes.extend_from_slice(&false_colour(t));
+    }
+    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width as u32, height as u32);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.add_text_chunk("acr-scale".to_owned(), scale.to_owned())
+        .map_err(|e| e.to_string())?;
+    let mut w = enc.write_header().map_err(|e| e.to_string())?;
+    w.write_image_data(&bytes).map_err(|e| e.to_string())?;
+    w.finish().map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_requests() {
+        let r = parse_aovs("spp=a.png,variance=b.exr").unwrap();
+        assert_eq!(r.len(), 2);
+        assert_eq!(r[1].name, "variance");
+        assert_eq!(r[1].path, PathBuf::from("b.exr"));
+        let e = parse_aovs("sp=a.png").unwrap_err();
+        assert!(e.contains("did you mean \"spp\""), "{e}");
+        assert!(parse_aovs("spp").is_err());
+        assert!(parse_aovs("spp=").is_err());
+    }
+
+    #[test]
+    fn false_colour_runs_black_to_white() {
+        assert_eq!(false_colour(0.0), [0, 0, 0]);
+        assert_eq!(false_colour(1.0), [255, 255, 255]);
+        assert_eq!(false_colour(f32::NAN), [0, 0, 0]);
+        // Brighter with the value.
+        let lum = |c: [u8; 3]| c.iter().map(|&v| u32::from(v)).sum::<u32>();
+        let mut last = 0;
+        for i in 0..=20 {
+            let l = lum(false_colour(i as f32 / 20.0));
+            assert!(l >= last, "{i}");
+            last = l;
+        }
+    }
+}

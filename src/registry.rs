@@ -1,0 +1,129 @@
+//! The registry of every plugin by kind and name (samplers and filters from acr-plugins,
+//! integrators from here), and the choice of the three plugins of a render: the scene's
+//! directives, overridden by the command line.
+
+use crate::integrator::{Integrator, IntegratorBuild, INTEGRATORS};
+use acr_parser::{Result, SceneDescription, Warning};
+use acr_plugins::filters::FilterBuild;
+use acr_plugins::registry::{check_params, lookup};
+use acr_plugins::sampler::SamplerBuild;
+use acr_plugins::{Choice, Entry, Filter, Kind, PluginInfo, Sampler, SamplerSetup, Setting};
+use acr_plugins::{FILTERS, SAMPLERS};
+
+/// Every plugin by kind.
+pub fn all() -> impl Iterator<Item = &'static PluginInfo> {
+    let s = SAMPLERS.iter().map(|e| &e.info);
+    let f = FILTERS.iter().map(|e| &e.info);
+    let i = INTEGRATORS.iter().map(|e| &e.info);
+    s.chain(f).chain(i)
+}
+
+/// The command line's plugin choices (`--sampler`, `--filter`, `--integrator`, `--set`).
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// `--sampler NAME`.
+    pub sampler: Option<String>,
+    /// `--filter NAME`.
+    pub filter: Option<String>,
+    /// `--integrator NAME`.
+    pub integrator: Option<String>,
+    /// `--set KIND.PARAM=VALUE`, in order (a later one wins).
+    pub settings: Vec<Setting>,
+}
+
+/// The plugins of one render.
+pub struct Plugins {
+    /// Where the samples go.
+    pub sampler: Box<dyn Sampler>,
+    /// How the image is reconstructed.
+    pub filter: Box<dyn Filter>,
+    /// What each sample estimates.
+    pub integrator: Integrator,
+}
+
+/// Looks the choice up, applies the `--set`s of its kind and checks its parameters.
+fn resolve<'a, B>(
+    entries: &'a [Entry<B>],
+    kind: Kind,
+    choice: &mut Choice,
+    overrides: &Overrides,
+    warnings: &mut Vec<Warning>,
+) -> Result<&'a Entry<B>> {
+    let entry = lookup(entries, kind, &choice.name, choice.loc.as_ref(), warnings)?;
+    for s in overrides.settings.iter().filter(|s| s.kind == kind) {
+        s.apply(&entry.info, choice)?;
+    }
+    check_params(&entry.info, choice, warnings)?;
+    Ok(entry)
+}
+
+/// Chooses and builds the sampler, filter and integrator: the scene's directives, with the
+/// command line's names and settings on top. Without a directive, pbrt-v3's defaults: the
+/// `halton` sampler at 16 spp, the `box` filter and the `path` integrator.
+pub fn choose(
+    desc: &SceneDescription,
+    overrides: &Overrides,
+    setup: impl FnOnce() -> SamplerSetup,
+    warnings: &mut Vec<Warning>,
+) -> Result<Plugins> {
+    let mut ic = Choice::new(
+        desc.integrator.as_ref(),
+        "path",
+        overrides.integrator.as_deref(),
+    );
+    let ie: &Entry<IntegratorBuild> =
+        resolve(INTEGRATORS, Kind::Integrator, &mut ic, overrides, warnings)?;
+    let integrator = (ie.build)(&ic)?;
+
+    let mut fc = Choice::new(desc.filter.as_ref(), "box", overrides.filter.as_deref());
+    let fe: &Entry<FilterBuild> = resolve(FILTERS, Kind::Filter, &mut fc, overrides, warnings)?;
+    let filter = (fe.build)(&fc)?;
+
+    let mut sc = Choice::new(
+        desc.sampler.as_ref(),
+        "halton",
+        overrides.sampler.as_deref(),
+    );
+    let se: &Entry<SamplerBuild> = resolve(SAMPLERS, Kind::Sampler, &mut sc, overrides, warnings)?;
+    let sampler = (se.build)(&sc, &setup())?;
+    // `check_params` has warned of what the plugins do not declare, on its copies; the
+    // directives' own parameters need no second, vaguer warning.
+    for d in [&desc.sampler, &desc.filter, &desc.integrator]
+        .into_iter()
+        .flatten()
+    {
+        for p in d.params.iter() {
+            p.mark_used();
+        }
+    }
+    Ok(Plugins {
+        sampler,
+        filter,
+        integrator,
+    })
+}
+
+/// `acr plugins`: every plugin by kind, with its parameters and defaults, as text.
+pub fn describe() -> String {
+    let mut out = String::new();
+    for kind in [Kind::Sampler, Kind::Filter, Kind::Integrator] {
+        out.push_str(&format!("{}s:\n", kind.name()));
+        for info in all().filter(|i| i.kind == kind) {
+            out.push_str(&format!("  {:<16}{}\n", info.name, info.doc));
+            for p in info.params {
+                let decl = format!("{} {}", p.ty.name(), p.name);
+                out.push_str(&format!(
+                    "      {:<28} default {:<10} {}\n",
+                    decl, p.default, p.doc
+                ));
+            }
+        }
+        out.push('\n');
+    }
+    out.push_str(
+        "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
+         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, mlt, sppm, volpath, \
+         ambientocclusion -> path, whitted -> directlighting.\n",
+    );
+    out
+}
