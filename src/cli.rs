@@ -35,6 +35,15 @@ pub enum Command {
     Render(RenderArgs),
     /// List every plugin (samplers, filters, integrators) with its parameters and defaults.
     Plugins,
+    /// Time against error: render a manifest's scenes with its methods at its budgets, and
+    /// write a CSV, a plot per scene and a Markdown report.
+    Bench {
+        /// The manifest (TOML; see bench/ for examples).
+        manifest: PathBuf,
+        /// Output folder (default: bench-out/MANIFEST-NAME).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Compare an image with a reference: MSE, relMSE and PSNR (linear radiance).
     Diff {
         /// The image to judge (.exr, .pfm, .hdr or .png).
@@ -100,6 +109,7 @@ pub fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Parse { scene } => parse(&scene),
         Command::Render(args) => render_command(&args),
+        Command::Bench { manifest, out } => bench_command(&manifest, out),
         Command::Plugins => {
             print!("{}", crate::registry::describe());
             Ok(())
@@ -303,6 +313,30 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             output.display()
         );
     }
+    Ok(())
+}
+
+fn bench_command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
+    let out = out.unwrap_or_else(|| {
+        let stem = manifest
+            .file_stem()
+            .map_or_else(|| "bench".to_owned(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("bench-out").join(stem)
+    });
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find acr itself: {e}"))?;
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let opts = crate::bench::BenchOptions {
+        exe,
+        out: out.clone(),
+        command,
+    };
+    let rows = crate::bench::run_bench(manifest, &opts)?;
+    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    eprintln!(
+        "{} runs, {failed} failed -> {}",
+        rows.len(),
+        out.join("report.md").display()
+    );
     Ok(())
 }
 

@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod aov;
+pub mod bench;
 pub mod bsdf;
 pub mod camera;
 pub mod cli;

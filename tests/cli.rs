@@ -913,3 +913,76 @@ fn every_sampler_gives_the_same_file_with_one_and_two_threads() {
         assert!(run("1") == run("2"), "{sampler}: 1 and 2 threads differ");
     }
 }
+
+#[test]
+fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
+    let dir = TempDir::new("bench");
+    dir.write("s.pbrt", &small_scene(""));
+    let manifest = dir.write(
+        "m.toml",
+        "title = \"tiny\"\nseed = 3\nthreads = 2\n[budgets]\nspp = [1, 4]\nequal_time = true\n\
+         [reference]\nsampler = \"sobol\"\nfilter = \"box\"\nspp = 64\n\
+         [[scene]]\nname = \"small\"\npath = \"s.pbrt\"\n\
+         [[method]]\nlabel = \"random+box\"\nsampler = \"random\"\nfilter = \"box\"\n\
+         [[method]]\nlabel = \"sobol+gaussian\"\nsampler = \"sobol\"\nfilter = \"gaussian\"\n\
+         set = [\"filter.alpha=3\"]\n\
+         [[method]]\nlabel = \"broken\"\nsampler = \"nosuch\"\n",
+    );
+    let out = dir.join("out");
+    let run = || {
+        let o = acr([
+            "bench",
+            manifest.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let err = run();
+    assert!(err.contains("rendering the reference"), "{err}");
+    // A progress line per run: 2 budgets x (3 equal-spp + 2 equal-time).
+    assert_eq!(err.matches("] small ").count(), 10, "{err}");
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        lines[0],
+        "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status"
+    );
+    assert_eq!(lines.len(), 11);
+    let ok: Vec<&str> = lines[1..]
+        .iter()
+        .copied()
+        .filter(|l| l.ends_with(",ok"))
+        .collect();
+    assert_eq!(ok.len(), 6, "{csv}");
+    assert!(lines
+        .iter()
+        .filter(|l| l.contains("broken"))
+        .all(|l| l.contains("failed:") && l.contains("nosuch")));
+    // Equal-spp rows took their budget exactly; errors are finite and fall with samples.
+    let field = |l: &str, i: usize| l.split(',').nth(i).unwrap().parse::<f64>().unwrap();
+    let eq = |m: &str, spp: &str| {
+        *lines
+            .iter()
+            .find(|l| l.starts_with(&format!("small,{m},equal-spp,{spp},")))
+            .unwrap()
+    };
+    for m in ["random+box", "sobol+gaussian"] {
+        assert_eq!(field(eq(m, "1"), 6), 1.0);
+        assert_eq!(field(eq(m, "4"), 6), 4.0);
+        assert!(
+            field(eq(m, "4"), 7) < field(eq(m, "1"), 7),
+            "{m}: MSE falls"
+        );
+    }
+    let plot = std::fs::read(out.join("small.png")).unwrap();
+    assert!(plot.len() > 1000 && plot.starts_with(b"\x89PNG"));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("# tiny"));
+    assert!(report.contains("**4 runs failed**"), "{report}");
+    assert!(report.contains("| 4 | sobol+gaussian |"), "{report}");
+    // The reference is cached: a second run does not render it again.
+    let err = run();
+    assert!(!err.contains("rendering the reference"), "{err}");
+}
