@@ -218,20 +218,6 @@ impl Pcg32 {
     pub(crate) fn next_f32(&mut self) -> f32 {
         (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
     }
-
-    /// A uniform integer in [0, n) (multiply-shift; its bias of n / 2^32 is negligible here).
-    #[inline]
-    pub(crate) fn below(&mut self, n: u32) -> u32 {
-        ((u64::from(self.next_u32()) * u64::from(n)) >> 32) as u32
-    }
-
-    /// Shuffles `v` in place (Fisher-Yates).
-    pub(crate) fn shuffle<T>(&mut self, v: &mut [T]) {
-        for i in (1..v.len()).rev() {
-            let j = self.below(i as u32 + 1) as usize;
-            v.swap(i, j);
-        }
-    }
 }
 
 #[cfg(test)]

@@ -1,10 +1,12 @@
 //! `stratified`: pbrt-v3's StratifiedSampler. The film offset takes one sample in each of
 //! xsamples x ysamples strata (jittered, or at the stratum centre with jitter off); time takes
 //! one in each of spp 1D strata and the lens one in each of xsamples x ysamples 2D strata.
-//! Each dim's strata are shuffled separately, from the seed and pixel, so that sample i's
+//! Each dim's strata are permuted separately, from the seed and pixel, so that sample i's
 //! film stratum says nothing of its time or lens stratum (pbrt-v3 shuffles for the same reason).
+//! The permutation is evaluated per sample (pbrt-v4's PermutationElement), not stored, so a
+//! pass of a few samples costs a few samples' work however many strata the pixel has.
 
-use super::{pixel_key, Pcg32, PixelCursor, Sampler};
+use super::{mix64, pixel_key, PixelCursor, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_stratum, RenderingSpace, SamplePoint};
@@ -12,9 +14,6 @@ use acr_parser::{ParamType, Result};
 
 /// Salt of this sampler's per-pixel keys.
 const SALT: u64 = 0x7374_7261;
-
-/// A sample's stratum `(kx, ky)` and its position `(jx, jy)` in [0, 1)^2 within the stratum.
-type Cell = (u32, u32, f32, f32);
 
 /// Jittered stratified points over the active dims.
 #[derive(Clone, Debug)]
@@ -24,10 +23,47 @@ pub struct StratifiedSampler {
     ysamples: u32,
     jitter: bool,
     seed: u64,
-    // Per-pixel scratch, reused so that a batch allocates nothing.
-    film: Vec<Cell>,
-    time: Vec<Cell>,
-    lens: Vec<Cell>,
+}
+
+/// Element `i` of a pseudo-random permutation of `0..l` chosen by `p` (Kensler's hashed
+/// permutation, as pbrt-v4's PermutationElement): a bijection of `0..l`, in O(1) expected time.
+pub(crate) fn permutation_element(mut i: u32, l: u32, p: u32) -> u32 {
+    let mut w = l - 1;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    loop {
+        i ^= p;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= p >> 16;
+        i ^= (i & w) >> 4;
+        i ^= p >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= p >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | (p >> 27));
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < l {
+            break;
+        }
+    }
+    ((u64::from(i) + u64::from(p)) % u64::from(l)) as u32
+}
+
+/// A uniform value in [0, 1) from a 64-bit hash (24 bits, so it never rounds to 1).
+#[inline]
+fn unit(h: u64) -> f32 {
+    (h >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 impl StratifiedSampler {
@@ -47,57 +83,44 @@ impl StratifiedSampler {
             ysamples,
             jitter,
             seed,
-            film: Vec::new(),
-            time: Vec::new(),
-            lens: Vec::new(),
         }
     }
 
-    /// Fills `cells` with one point per stratum of an `nx` x `ny` grid, then shuffles them.
-    fn strata(cells: &mut Vec<Cell>, nx: u32, ny: u32, jitter: bool, rng: &mut Pcg32) {
-        cells.clear();
-        for ky in 0..ny {
-            for kx in 0..nx {
-                let (jx, jy) = if jitter {
-                    (rng.next_f32(), rng.next_f32())
-                } else {
-                    (0.5, 0.5)
-                };
-                cells.push((kx, ky, jx, jy));
-            }
-        }
-        rng.shuffle(cells);
-    }
-
-    fn pixel(&mut self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
+    fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
         let dims = self.cursor.space().dims;
         let (nx, ny, jitter) = (self.xsamples, self.ysamples, self.jitter);
         let spp = nx * ny;
-        let mut rng = Pcg32::new(pixel_key(p, self.seed, SALT), 0);
-        Self::strata(&mut self.film, nx, ny, jitter, &mut rng);
-        // Inactive dims draw nothing: a pinhole still scene pays for x and y only.
-        if dims.time {
-            Self::strata(&mut self.time, spp, 1, jitter, &mut rng);
-        }
-        if dims.lens {
-            Self::strata(&mut self.lens, nx, ny, jitter, &mut rng);
-        }
+        let key = pixel_key(p, self.seed, SALT);
+        // One permutation and one jitter stream per dim group: film, time, lens.
+        let perm: [u32; 3] = std::array::from_fn(|d| mix64(key ^ (d as u64 + 1)) as u32);
+        // The stratum of sample `index` in group `d` and its jitter within it.
+        let cell = |index: u32, d: usize| -> (u32, [f32; 2]) {
+            let k = permutation_element(index, spp, perm[d]);
+            let j = if jitter {
+                let h = mix64(key ^ mix64((u64::from(index) << 2) | d as u64));
+                [unit(h), unit(mix64(h))]
+            } else {
+                [0.5; 2]
+            };
+            (k, j)
+        };
         // Position `j` within stratum `k` of `n`, as an f32 kept inside that stratum.
         let at = |base: u32, k: u32, n: u32, j: f32| {
             in_stratum(base, k, n, (f64::from(k) + f64::from(j)) / f64::from(n))
         };
         for index in indices {
-            let (kx, ky, jx, jy) = self.film[index as usize];
-            let film = [at(p[0], kx, nx, jx), at(p[1], ky, ny, jy)];
+            let (k, j) = cell(index, 0);
+            let film = [at(p[0], k % nx, nx, j[0]), at(p[1], k / nx, ny, j[1])];
+            // Inactive dims draw nothing: a pinhole still scene pays for x and y only.
             let time = if dims.time {
-                let (k, _, j, _) = self.time[index as usize];
-                at(0, k, spp, j)
+                let (k, j) = cell(index, 1);
+                at(0, k, spp, j[0])
             } else {
                 0.5
             };
             let lens = if dims.lens {
-                let (kx, ky, jx, jy) = self.lens[index as usize];
-                [at(0, kx, nx, jx), at(0, ky, ny, jy)]
+                let (k, j) = cell(index, 2);
+                [at(0, k % nx, nx, j[0]), at(0, k / nx, ny, j[1])]
             } else {
                 [0.5; 2]
             };
@@ -211,6 +234,29 @@ pub fn square_grid(n: u32) -> (u32, u32) {
         xs -= 1;
     }
     (xs, n / xs)
+}
+
+#[cfg(test)]
+mod permutation_tests {
+    use super::permutation_element;
+
+    #[test]
+    fn permutation_element_is_a_bijection() {
+        for l in [1u32, 2, 3, 16, 17, 100, 1024] {
+            for p in [0u32, 1, 0xdead_beef, 12345] {
+                let mut seen = vec![false; l as usize];
+                for i in 0..l {
+                    let k = permutation_element(i, l, p);
+                    assert!(k < l && !seen[k as usize], "l {l} p {p} i {i}");
+                    seen[k as usize] = true;
+                }
+            }
+        }
+        // Different keys, different orders.
+        let a: Vec<u32> = (0..16).map(|i| permutation_element(i, 16, 1)).collect();
+        let b: Vec<u32> = (0..16).map(|i| permutation_element(i, 16, 2)).collect();
+        assert_ne!(a, b);
+    }
 }
 
 #[cfg(test)]
