@@ -8,7 +8,7 @@
 
 use crate::geometry::{Ray, SurfaceInteraction, Vec3};
 use crate::shapes::triangle::{
-    intersect_triangle_vertices, triangle_bounds, triangle_interaction, TriangleRay,
+    intersect_triangle_verts, triangle_bounds, triangle_interaction, TriangleRay, TriangleVerts,
 };
 use crate::shapes::{Cylinder, Disk, Sphere, TriangleMesh};
 use crate::transform::MotionTransform;
@@ -60,7 +60,7 @@ pub struct Geometry {
     prims: Vec<Prim>,
     /// The vertices of each triangle primitive, in leaf order beside `prims` (zeros for other
     /// kinds): the traversal reads one contiguous record instead of three indirections.
-    tri_verts: Vec<[Vec3; 3]>,
+    tri_verts: Vec<TriangleVerts>,
     bvh: Option<CwBvh>,
 }
 
@@ -162,9 +162,9 @@ impl Geometry {
             .iter()
             .map(|p| match p.kind {
                 PrimKind::Triangle { mesh, tri } => {
-                    self.meshes[mesh as usize].vertices(tri as usize)
+                    TriangleVerts::new(&self.meshes[mesh as usize].vertices(tri as usize))
                 }
-                _ => [Vec3::ZERO; 3],
+                _ => TriangleVerts::default(),
             })
             .collect();
         self.bvh = Some(bvh);
@@ -181,7 +181,7 @@ impl Geometry {
     ) -> Option<(f32, LocalHit)> {
         match self.prims[id].kind {
             PrimKind::Triangle { .. } => {
-                intersect_triangle_vertices(&self.tri_verts[id], tri_ray, t_max)
+                intersect_triangle_verts(&self.tri_verts[id], tri_ray, t_max)
                     .map(|h| (h.t, LocalHit::Triangle(h)))
             }
             PrimKind::Sphere(i) => self.spheres[i as usize]

@@ -6,6 +6,8 @@
 //! indexed by the sample's index within its pixel (as pbrt-v4's padded Sobol sampler), so the
 //! samples of one pixel are stratified in every dimension; later dimensions from a PCG stream.
 
+use sobol_burley::parts::{hash, hash_int4, owen_scramble_int4_rev, owen_scramble_rev, Int4};
+
 /// A hash of 64 bits to 64 bits (SplitMix64's finaliser).
 #[inline]
 pub fn mix64(mut x: u64) -> u64 {
@@ -58,6 +60,62 @@ impl Pcg32 {
 /// Samples per pixel that the Sobol sequence covers (sobol_burley's limit).
 const SOBOL_SAMPLES: u32 = 1 << 16;
 
+/// Dimension sets (of four dimensions) served from [`SobolTables`]; later sets (past the
+/// 64th dimension) are computed by `sobol_burley::sample_4d` directly.
+const TABLE_SETS: u32 = 16;
+
+/// The unscrambled Sobol points of the first [`TABLE_SETS`] dimension sets, by nibble of the
+/// (16-bit) index: a point is the XOR of the direction vectors of its index's bits, so the
+/// XOR of four nibble entries equals sobol_burley's loop over up to 16 bits, bit for bit.
+#[derive(Debug)]
+struct SobolTables(Vec<[[Int4; 16]; 4]>);
+
+impl SobolTables {
+    fn get() -> &'static Self {
+        static TABLES: std::sync::OnceLock<SobolTables> = std::sync::OnceLock::new();
+        TABLES.get_or_init(|| {
+            Self(
+                (0..TABLE_SETS)
+                    .map(|set| {
+                        std::array::from_fn(|nibble| {
+                            std::array::from_fn(|v| {
+                                // The index's top 16 bits, most significant nibble first.
+                                let bits = (v as u32) << (28 - 4 * nibble);
+                                sobol_burley::parts::sobol_int4_rev(bits, set)
+                            })
+                        })
+                    })
+                    .collect(),
+            )
+        })
+    }
+
+    /// `sobol_burley::sample_4d(index, set, seed)` for a set below [`TABLE_SETS`], given
+    /// `shuffled` (the index as it scrambles it, see [`shuffled_index`]).
+    #[inline]
+    fn sample_4d(&self, shuffled: u32, set: u32, seed: u32) -> [f32; 4] {
+        let t = &self.0[set as usize];
+        let nib = |k: usize| ((shuffled >> (28 - 4 * k)) & 0xf) as usize;
+        let sobol = t[0][nib(0)] ^ t[1][nib(1)] ^ t[2][nib(2)] ^ t[3][nib(3)];
+        // As sobol_burley::sample_4d from here on.
+        let scramble = {
+            let seed: Int4 = [seed.wrapping_mul(0x9c8f2d3b); 4].into();
+            let ds: Int4 = [set; 4].into();
+            seed ^ ds ^ [0x912f69ba, 0x174f18ab, 0x691e72ca, 0xb40cc1b8].into()
+        };
+        owen_scramble_int4_rev(sobol, hash_int4(scramble))
+            .reverse_bits()
+            .to_f32_norm()
+    }
+}
+
+/// The sample index as sobol_burley's `sample_4d` scrambles it for `seed` (the same for every
+/// dimension set).
+#[inline]
+fn shuffled_index(index: u32, seed: u32) -> u32 {
+    owen_scramble_rev(index.reverse_bits(), hash(seed ^ 0x79c68e4a))
+}
+
 /// The random numbers of one sample.
 #[derive(Clone, Debug)]
 pub struct SampleStream {
@@ -69,6 +127,9 @@ pub struct SampleStream {
     block: [f32; 4],
     /// The set `block` holds, or `u32::MAX` for none.
     block_set: u32,
+    /// The sample index as the Sobol scrambling shuffles it ([`shuffled_index`]).
+    shuffled: u32,
+    tables: &'static SobolTables,
     rng: Pcg32,
 }
 
@@ -83,6 +144,8 @@ impl SampleStream {
             dim: first_dim,
             block: [0.0; 4],
             block_set: u32::MAX,
+            shuffled: shuffled_index(index, key as u32),
+            tables: SobolTables::get(),
             // The index is hashed into the seed: PCG streams whose seeds and increments differ
             // by small steps start out correlated.
             rng: Pcg32::new(
@@ -101,7 +164,11 @@ impl SampleStream {
         if d < sobol_burley::NUM_DIMENSIONS && self.index < SOBOL_SAMPLES {
             let set = d / 4;
             if set != self.block_set {
-                self.block = sobol_burley::sample_4d(self.index, set, self.scramble);
+                self.block = if set < TABLE_SETS {
+                    self.tables.sample_4d(self.shuffled, set, self.scramble)
+                } else {
+                    sobol_burley::sample_4d(self.index, set, self.scramble)
+                };
                 self.block_set = set;
             }
             self.block[(d % 4) as usize]
@@ -132,8 +199,18 @@ mod tests {
         }
         // The same values as one dimension at a time.
         let mut d = SampleStream::new(17, 3, 42, 5);
-        for dim in 5..40 {
+        for dim in 5..(4 * TABLE_SETS + 40) {
             assert_eq!(d.next_1d(), sobol_burley::sample(3, dim, d.scramble));
+        }
+        // The tables give sobol_burley's values, whatever the index and seed.
+        let tables = SobolTables::get();
+        for (index, seed) in [(0, 0), (1, 7), (5, 0xdead_beef), (65_535, 3), (40_000, 99)] {
+            for set in 0..TABLE_SETS {
+                assert_eq!(
+                    tables.sample_4d(shuffled_index(index, seed), set, seed),
+                    sobol_burley::sample_4d(index, set, seed)
+                );
+            }
         }
         // Past the Sobol sequence's 2^16 samples, values are still in range.
         let mut late = SampleStream::new(17, 1 << 17, 42, 0);

@@ -242,13 +242,12 @@ impl Splat {
         let rx = self.radius.0;
         let (cx0, cx1) = self.columns;
         let dx = p.x - 0.5;
-        let x0 = ((dx - rx).ceil() as i64).max(cx0);
-        let x1 = ((dx + rx).floor() as i64 + 1).min(cx1);
+        let x0 = ceil_i64(dx - rx).max(cx0);
+        let x1 = floor_i64(dx + rx).saturating_add(1).min(cx1);
         let mut fx = [0u8; MAX_SPAN];
         let mut n = 0u8;
         for (slot, x) in fx.iter_mut().zip(x0..x1) {
-            let f = ((x as f32 - dx).abs() / rx * TABLE_SIZE as f32) as usize;
-            *slot = f.min(TABLE_SIZE - 1) as u8;
+            *slot = table_index((x as f32 - dx).abs() / rx);
             n += 1;
         }
         Prepared {
@@ -268,7 +267,7 @@ impl Splat {
         if ay > ry || s.n == 0 {
             return;
         }
-        let fy = ((ay / ry * TABLE_SIZE as f32) as usize).min(TABLE_SIZE - 1);
+        let fy = table_index(ay / ry) as usize;
         let table_row = &self.table[fy * TABLE_SIZE..][..TABLE_SIZE];
         let start = (s.x0 - self.columns.0) as usize;
         let cells = &mut row[start..start + s.n as usize];
@@ -293,6 +292,36 @@ impl Splat {
         } else {
             l
         }
+    }
+}
+
+/// The filter-table entry for a distance `r` in units of the filter radius (r >= 0, not NaN):
+/// `min(floor(r * TABLE_SIZE), TABLE_SIZE - 1)`, clamping before the conversion (the same
+/// value for such `r`) so that it is one narrow conversion instead of a saturating one to usize.
+#[inline]
+fn table_index(r: f32) -> u8 {
+    (r * TABLE_SIZE as f32).min((TABLE_SIZE - 1) as f32) as u8
+}
+
+/// `v.ceil() as i64` without a libm call (baseline x86-64 has no rounding instruction).
+#[inline]
+fn ceil_i64(v: f32) -> i64 {
+    let t = v as i64;
+    if (t as f32) < v {
+        t.saturating_add(1)
+    } else {
+        t
+    }
+}
+
+/// `v.floor() as i64` without a libm call.
+#[inline]
+fn floor_i64(v: f32) -> i64 {
+    let t = v as i64;
+    if (t as f32) > v {
+        t.saturating_sub(1)
+    } else {
+        t
     }
 }
 
@@ -475,6 +504,48 @@ impl Film {
 mod tests {
     use super::*;
     use crate::filters::{BoxFilter, GaussianFilter};
+
+    #[test]
+    fn integer_rounding_matches_libm() {
+        let values = [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            2.999_999_8,
+            -2.999_999_8,
+            1e7 + 0.5,
+            3.0e9,
+            -3.0e9,
+            1e30,
+            -1e30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for v in values {
+            assert_eq!(ceil_i64(v), v.ceil() as i64, "ceil {v}");
+            assert_eq!(floor_i64(v), v.floor() as i64, "floor {v}");
+        }
+        for r in [
+            0.0f32,
+            0.03,
+            0.5,
+            0.937_5,
+            0.999_99,
+            1.0,
+            1.2,
+            1e9,
+            f32::INFINITY,
+        ] {
+            let want = ((r * TABLE_SIZE as f32) as usize).min(TABLE_SIZE - 1);
+            assert_eq!(table_index(r) as usize, want, "{r}");
+        }
+    }
 
     #[test]
     fn box_filter_averages_samples_in_the_pixel() {

@@ -4,6 +4,7 @@
 use super::{coordinate_system, faceforward, gamma, Transform};
 use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
 use crate::sampling::uniform_sample_triangle;
+use glam::{Vec3A, Vec3Swizzles};
 
 /// A triangle mesh with its vertices already in the space it is intersected in (world space for
 /// static meshes, as pbrt-v3 stores them).
@@ -164,6 +165,34 @@ impl TriangleRay {
     }
 }
 
+/// A triangle's vertices stored by coordinate (the x of all three, then the y, then the z),
+/// so that the watertight test's per-vertex steps run on all three vertices at once.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TriangleVerts {
+    xyz: [Vec3A; 3],
+}
+
+impl TriangleVerts {
+    /// From the three vertex positions.
+    #[inline]
+    pub fn new(p: &[Vec3; 3]) -> Self {
+        let [a, b, c] = *p;
+        Self {
+            xyz: [
+                Vec3A::new(a.x, b.x, c.x),
+                Vec3A::new(a.y, b.y, c.y),
+                Vec3A::new(a.z, b.z, c.z),
+            ],
+        }
+    }
+
+    /// Vertex `i`.
+    #[inline]
+    fn vertex(&self, i: usize) -> Vec3 {
+        Vec3::new(self.xyz[0][i], self.xyz[1][i], self.xyz[2][i])
+    }
+}
+
 /// [`intersect_triangle`] on the triangle's three vertices and a prepared ray.
 #[inline]
 pub fn intersect_triangle_vertices(
@@ -171,54 +200,60 @@ pub fn intersect_triangle_vertices(
     r: &TriangleRay,
     t_max: f32,
 ) -> Option<TriangleHit> {
+    intersect_triangle_verts(&TriangleVerts::new(p), r, t_max)
+}
+
+/// [`intersect_triangle`] on vertices stored by coordinate and a prepared ray.
+#[inline]
+pub fn intersect_triangle_verts(
+    v: &TriangleVerts,
+    r: &TriangleRay,
+    t_max: f32,
+) -> Option<TriangleHit> {
     // One version per permutation: with the axes known at compile time, permuting the
-    // vertices is plain register moves instead of three indexed selections per coordinate.
+    // vertices is a choice of rows instead of three indexed selections per coordinate.
     match (r.kx, r.ky, r.kz) {
-        (1, 2, 0) => intersect_permuted::<1, 2, 0>(p, r, t_max),
-        (2, 0, 1) => intersect_permuted::<2, 0, 1>(p, r, t_max),
-        _ => intersect_permuted::<0, 1, 2>(p, r, t_max),
+        (1, 2, 0) => intersect_permuted::<1, 2, 0>(v, r, t_max),
+        (2, 0, 1) => intersect_permuted::<2, 0, 1>(v, r, t_max),
+        _ => intersect_permuted::<0, 1, 2>(v, r, t_max),
     }
 }
 
-/// [`intersect_triangle_vertices`] for the ray's axis permutation (`KX`, `KY`, `KZ`).
+/// [`intersect_triangle_verts`] for the ray's axis permutation (`KX`, `KY`, `KZ`). Lane `i`
+/// of `xs`, `ys`, `zs` is vertex `i`'s transformed coordinate; every lane operation is the
+/// scalar operation pbrt-v3 performs per vertex, so the results are the same bits.
 #[inline(always)]
 fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
-    p: &[Vec3; 3],
+    v: &TriangleVerts,
     r: &TriangleRay,
     t_max: f32,
 ) -> Option<TriangleHit> {
     debug_assert_eq!((r.kx, r.ky, r.kz), (KX, KY, KZ));
-    let [p0, p1, p2] = *p;
-    let permute = |v: Vec3| Vec3::new(v[KX], v[KY], v[KZ]);
     // Translate to the ray origin and permute.
-    let mut p0t = permute(p0 - r.o);
-    let mut p1t = permute(p1 - r.o);
-    let mut p2t = permute(p2 - r.o);
+    let mut xs = v.xyz[KX] - Vec3A::splat(r.o[KX]);
+    let mut ys = v.xyz[KY] - Vec3A::splat(r.o[KY]);
+    let zs = v.xyz[KZ] - Vec3A::splat(r.o[KZ]);
 
     // Shear so that the ray direction becomes +z.
-    let (sx, sy, sz) = (r.sx, r.sy, r.sz);
-    p0t.x += sx * p0t.z;
-    p0t.y += sy * p0t.z;
-    p1t.x += sx * p1t.z;
-    p1t.y += sy * p1t.z;
-    p2t.x += sx * p2t.z;
-    p2t.y += sy * p2t.z;
+    xs += Vec3A::splat(r.sx) * zs;
+    ys += Vec3A::splat(r.sy) * zs;
 
-    // Edge function coefficients.
-    let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
-    let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
-    let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
+    // Edge function coefficients: e_i from the two other vertices (i + 1, i + 2).
+    let e = xs.yzx() * ys.zxy() - ys.yzx() * xs.zxy();
+    let (mut e0, mut e1, mut e2) = (e.x, e.y, e.z);
+    let [p0x, p1x, p2x] = xs.to_array();
+    let [p0y, p1y, p2y] = ys.to_array();
 
     // Fall back to double precision at triangle edges.
     if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let p2txp1ty = p2t.x as f64 * p1t.y as f64;
-        let p2typ1tx = p2t.y as f64 * p1t.x as f64;
+        let p2txp1ty = p2x as f64 * p1y as f64;
+        let p2typ1tx = p2y as f64 * p1x as f64;
         e0 = (p2typ1tx - p2txp1ty) as f32;
-        let p0txp2ty = p0t.x as f64 * p2t.y as f64;
-        let p0typ2tx = p0t.y as f64 * p2t.x as f64;
+        let p0txp2ty = p0x as f64 * p2y as f64;
+        let p0typ2tx = p0y as f64 * p2x as f64;
         e1 = (p0typ2tx - p0txp2ty) as f32;
-        let p1txp0ty = p1t.x as f64 * p0t.y as f64;
-        let p1typ0tx = p1t.y as f64 * p0t.x as f64;
+        let p1txp0ty = p1x as f64 * p0y as f64;
+        let p1typ0tx = p1y as f64 * p0x as f64;
         e2 = (p1typ0tx - p1txp0ty) as f32;
     }
 
@@ -233,10 +268,8 @@ fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     }
 
     // Scaled hit distance and the ray's t range.
-    p0t.z *= sz;
-    p1t.z *= sz;
-    p2t.z *= sz;
-    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+    let [p0z, p1z, p2z] = (zs * Vec3A::splat(r.sz)).to_array();
+    let t_scaled = e0 * p0z + e1 * p1z + e2 * p2z;
     if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
         return None;
     }
@@ -252,10 +285,10 @@ fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     let t = t_scaled * inv_det;
 
     // Ensure that t is conservatively greater than zero (pbrt-v3's error bounds).
-    let max_zt = p0t.z.abs().max(p1t.z.abs()).max(p2t.z.abs());
+    let max_zt = p0z.abs().max(p1z.abs()).max(p2z.abs());
     let delta_z = gamma(3) * max_zt;
-    let max_xt = p0t.x.abs().max(p1t.x.abs()).max(p2t.x.abs());
-    let max_yt = p0t.y.abs().max(p1t.y.abs()).max(p2t.y.abs());
+    let max_xt = p0x.abs().max(p1x.abs()).max(p2x.abs());
+    let max_yt = p0y.abs().max(p1y.abs()).max(p2y.abs());
     let delta_x = gamma(5) * (max_xt + max_zt);
     let delta_y = gamma(5) * (max_yt + max_zt);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
@@ -267,6 +300,7 @@ fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     }
 
     // Zero-area triangles are kept in the mesh but never hit (their normal is undefined).
+    let (p0, p1, p2) = (v.vertex(0), v.vertex(1), v.vertex(2));
     if (p0 - p2).cross(p1 - p2) == Vec3::ZERO {
         return None;
     }
