@@ -390,6 +390,8 @@ pub struct BenchOptions {
     pub out: PathBuf,
     /// The command line that started it, for the report.
     pub command: String,
+    /// The git commit of the working tree when it started, for the report.
+    pub commit: String,
 }
 
 /// Equal-time runs may take up to this many times the budget's samples per pixel; the time
@@ -667,7 +669,7 @@ pub fn report_markdown(m: &Manifest, manifest: &Path, opts: &BenchOptions, rows:
             |t| t.to_string()
         )
     );
-    let _ = writeln!(s, "- commit: {}", commit());
+    let _ = writeln!(s, "- commit: {}", opts.commit);
     let _ = writeln!(s, "- seed: {}", m.seed);
     let _ = writeln!(
         s,
@@ -761,7 +763,7 @@ fn machine() -> String {
 }
 
 /// The git commit of the working tree, if git can tell.
-fn commit() -> String {
+pub fn commit() -> String {
     Command::new("git")
         .args(["describe", "--always", "--dirty"])
         .output()

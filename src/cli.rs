@@ -329,6 +329,7 @@ fn bench_command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
         exe,
         out: out.clone(),
         command,
+        commit: crate::bench::commit(),
     };
     let rows = crate::bench::run_bench(manifest, &opts)?;
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
