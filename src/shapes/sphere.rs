@@ -34,6 +34,9 @@ pub struct Sphere {
     world_area: f32,
     /// The transform's uniform scale when it is a similarity.
     similarity: Option<f32>,
+    /// World centre and radius for cone sampling (full spheres under similarities), computed
+    /// once: [`Sphere::cone`] runs for every light sample.
+    cone_base: Option<(Vec3, f64)>,
 }
 
 /// What [`Sphere::interaction`] needs from [`Sphere::intersect`].
@@ -69,9 +72,14 @@ impl Sphere {
             object_to_world,
             reverse_orientation,
             world_area: 0.0,
+            cone_base: None,
         };
         let t = s.object_to_world;
         s.world_area = world_area(&t, s.object_area(), |u| s.sample_object(u).normalize());
+        s.cone_base = s
+            .similarity
+            .filter(|_| s.is_full())
+            .map(|scale| (t.point(Vec3::ZERO), (s.radius * scale).abs() as f64));
         s
     }
 
@@ -236,12 +244,7 @@ impl Sphere {
     /// is partial, or the transform is not a similarity (where cone sampling does not apply).
     #[inline]
     fn cone(&self, ref_p: Vec3) -> Option<(Vec3, f64, f64, f64)> {
-        let s = self.similarity?;
-        if !self.is_full() {
-            return None;
-        }
-        let center = self.object_to_world.point(Vec3::ZERO);
-        let r = (self.radius * s).abs() as f64;
+        let (center, r) = self.cone_base?;
         let dc2 = (center - ref_p).as_dvec3().length_squared();
         // A point on the sphere itself (rounding puts half of them just outside) must take the
         // inside branch: from the surface the cone is a whole hemisphere whose sampled points
