@@ -671,11 +671,14 @@ pub struct Bsdf {
 impl Bsdf {
     /// An empty BSDF at `si`: shading frame from `si.shading_n` and `si.shading_dpdu`, geometric
     /// normal `si.n`, relative index `eta` (1 for surfaces that do not refract).
+    // Inlined so that the (large) BSDF is built in place rather than copied out.
+    #[inline]
     pub fn new(si: &SurfaceInteraction, eta: f32) -> Self {
         Self::from_frame(Frame::from_xz(si.shading_dpdu, si.shading_n), si.n, eta)
     }
 
     /// An empty BSDF with the given shading frame and geometric normal.
+    #[inline]
     pub fn from_frame(frame: Frame, ng: Vec3, eta: f32) -> Self {
         Self {
             frame,
@@ -693,6 +696,7 @@ impl Bsdf {
     }
 
     /// Adds a lobe with an RGB weight; returns false (and adds nothing) when full.
+    #[inline]
     pub fn add_scaled(&mut self, bxdf: Bxdf, scale: Spectrum) -> bool {
         if self.len == MAX_LOBES {
             return false;

@@ -156,7 +156,8 @@ impl SampleStream {
     }
 
     /// The next value in [0, 1).
-    #[inline]
+    // Always inlined: called a few dozen times per sample, and the call cost rivals the work.
+    #[inline(always)]
     pub fn next_1d(&mut self) -> f32 {
         let d = self.dim;
         self.dim += 1;
@@ -178,7 +179,7 @@ impl SampleStream {
     }
 
     /// The next pair of values in [0, 1)^2.
-    #[inline]
+    #[inline(always)]
     pub fn next_2d(&mut self) -> glam::Vec2 {
         glam::Vec2::new(self.next_1d(), self.next_1d())
     }
