@@ -4,7 +4,7 @@
 //! so pixels are independent while each keeps the sequence's stratification: among the first
 //! n points the base-b digits of i, hence the intervals of width b^-m, are balanced.
 
-use super::{mix64, pixel_key, PixelCursor, Sampler};
+use super::{mix64, pixel_key, PixelCursor, PixelPattern, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_pixel, RenderingSpace, SamplePoint, ONE_MINUS_EPSILON};
@@ -65,7 +65,6 @@ pub(crate) fn owen_radical_inverse<const B: u64>(mut a: u64, hash: u64, exact: u
 #[derive(Clone, Debug)]
 pub struct HaltonSampler {
     cursor: PixelCursor,
-    spp: u32,
     seed: u64,
     /// Per base (2, 3, 5, 7, 11): the scale down to which digits are scrambled one by one.
     exact: [u64; 5],
@@ -76,10 +75,21 @@ impl HaltonSampler {
     pub fn new(space: RenderingSpace, spp: u32, seed: u64) -> Self {
         Self {
             cursor: PixelCursor::new(space, spp),
-            spp,
             seed,
             exact: [2, 3, 5, 7, 11].map(|b| scale_for(b, u64::from(spp))),
         }
+    }
+}
+
+impl PixelPattern for HaltonSampler {
+    const NAME: &'static str = "halton";
+
+    fn cursor(&self) -> &PixelCursor {
+        &self.cursor
+    }
+
+    fn cursor_mut(&mut self) -> &mut PixelCursor {
+        &mut self.cursor
     }
 
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
@@ -116,32 +126,6 @@ impl HaltonSampler {
                 lens,
             });
         }
-    }
-}
-
-impl Sampler for HaltonSampler {
-    fn name(&self) -> &'static str {
-        "halton"
-    }
-
-    fn spp(&self) -> u32 {
-        self.spp
-    }
-
-    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        out.clear();
-        let Some((pixels, indices)) = self.cursor.next() else {
-            return false;
-        };
-        for i in pixels {
-            let p = self.cursor.space().pixel(i);
-            self.pixel(p, indices.clone(), out);
-        }
-        true
-    }
-
-    fn halt(&mut self) {
-        self.cursor.halt();
     }
 }
 

@@ -131,6 +131,11 @@ impl PixelCursor {
         &self.space
     }
 
+    /// Samples per pixel, unless halted.
+    pub(crate) fn spp(&self) -> u32 {
+        self.spp
+    }
+
     /// The next batch: row-major pixel indices and the sample indices each of them gets, or
     /// None when every pixel is done.
     pub(crate) fn next(&mut self) -> Option<(Range<u64>, Range<u32>)> {
@@ -161,6 +166,49 @@ impl PixelCursor {
         if self.next_pixel == 0 && self.pass_start > 0 {
             self.pass_start = self.spp;
         }
+    }
+}
+
+/// A sampler whose points in a pixel depend only on the pixel, the sample index and the seed.
+/// It walks the image with a [`PixelCursor`]; the walk, the budget and halting are the same for
+/// every such sampler, so implementing this trait gives [`Sampler`].
+pub(crate) trait PixelPattern: Send {
+    /// The plugin's name.
+    const NAME: &'static str;
+
+    /// The walk over the image.
+    fn cursor(&self) -> &PixelCursor;
+
+    /// The walk, to advance or halt it.
+    fn cursor_mut(&mut self) -> &mut PixelCursor;
+
+    /// Appends the points with sample indices `indices` of pixel `p` to `out`.
+    fn pixel(&self, p: [u32; 2], indices: Range<u32>, out: &mut Vec<SamplePoint>);
+}
+
+impl<T: PixelPattern> Sampler for T {
+    fn name(&self) -> &'static str {
+        T::NAME
+    }
+
+    fn spp(&self) -> u32 {
+        self.cursor().spp()
+    }
+
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+        out.clear();
+        let Some((pixels, indices)) = self.cursor_mut().next() else {
+            return false;
+        };
+        let space = *self.cursor().space();
+        for i in pixels {
+            self.pixel(space.pixel(i), indices.clone(), out);
+        }
+        true
+    }
+
+    fn halt(&mut self) {
+        self.cursor_mut().halt();
     }
 }
 

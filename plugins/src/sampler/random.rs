@@ -1,6 +1,6 @@
 //! `random`: independent uniform points, one PCG32 stream per pixel (pbrt-v3's RandomSampler).
 
-use super::{pixel_key, Pcg32, PixelCursor, Sampler};
+use super::{pixel_key, Pcg32, PixelCursor, PixelPattern, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_pixel, RenderingSpace, SamplePoint};
@@ -13,7 +13,6 @@ const SALT: u64 = 0x7261_6e64;
 #[derive(Clone, Debug)]
 pub struct RandomSampler {
     cursor: PixelCursor,
-    spp: u32,
     seed: u64,
 }
 
@@ -22,9 +21,20 @@ impl RandomSampler {
     pub fn new(space: RenderingSpace, spp: u32, seed: u64) -> Self {
         Self {
             cursor: PixelCursor::new(space, spp),
-            spp,
             seed,
         }
+    }
+}
+
+impl PixelPattern for RandomSampler {
+    const NAME: &'static str = "random";
+
+    fn cursor(&self) -> &PixelCursor {
+        &self.cursor
+    }
+
+    fn cursor_mut(&mut self) -> &mut PixelCursor {
+        &mut self.cursor
     }
 
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
@@ -58,32 +68,6 @@ impl RandomSampler {
                 lens,
             });
         }
-    }
-}
-
-impl Sampler for RandomSampler {
-    fn name(&self) -> &'static str {
-        "random"
-    }
-
-    fn spp(&self) -> u32 {
-        self.spp
-    }
-
-    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        out.clear();
-        let Some((pixels, indices)) = self.cursor.next() else {
-            return false;
-        };
-        for i in pixels {
-            let p = self.cursor.space().pixel(i);
-            self.pixel(p, indices.clone(), out);
-        }
-        true
-    }
-
-    fn halt(&mut self) {
-        self.cursor.halt();
     }
 }
 

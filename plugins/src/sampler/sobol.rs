@@ -3,7 +3,7 @@
 //! (pixel, seed). The first 2^k points of a pixel form a (0, k, 1)-net in each dim, so spp = 16
 //! puts one point in each 1/16 of every 1D projection.
 
-use super::{pixel_key, Pcg32, PixelCursor, Sampler};
+use super::{pixel_key, Pcg32, PixelCursor, PixelPattern, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_pixel, RenderingSpace, SamplePoint};
@@ -24,7 +24,6 @@ pub const SOBOL_DIMS_USED: u32 = 5;
 #[derive(Clone, Debug)]
 pub struct SobolSampler {
     cursor: PixelCursor,
-    spp: u32,
     seed: u64,
 }
 
@@ -33,9 +32,20 @@ impl SobolSampler {
     pub fn new(space: RenderingSpace, spp: u32, seed: u64) -> Self {
         Self {
             cursor: PixelCursor::new(space, spp),
-            spp,
             seed,
         }
+    }
+}
+
+impl PixelPattern for SobolSampler {
+    const NAME: &'static str = "sobol";
+
+    fn cursor(&self) -> &PixelCursor {
+        &self.cursor
+    }
+
+    fn cursor_mut(&mut self) -> &mut PixelCursor {
+        &mut self.cursor
     }
 
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
@@ -74,32 +84,6 @@ impl SobolSampler {
                 lens,
             });
         }
-    }
-}
-
-impl Sampler for SobolSampler {
-    fn name(&self) -> &'static str {
-        "sobol"
-    }
-
-    fn spp(&self) -> u32 {
-        self.spp
-    }
-
-    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        out.clear();
-        let Some((pixels, indices)) = self.cursor.next() else {
-            return false;
-        };
-        for i in pixels {
-            let p = self.cursor.space().pixel(i);
-            self.pixel(p, indices.clone(), out);
-        }
-        true
-    }
-
-    fn halt(&mut self) {
-        self.cursor.halt();
     }
 }
 

@@ -6,7 +6,7 @@
 //! The permutation is evaluated per sample (pbrt-v4's PermutationElement), not stored, so a
 //! pass of a few samples costs a few samples' work however many strata the pixel has.
 
-use super::{mix64, pixel_key, PixelCursor, Sampler};
+use super::{mix64, pixel_key, PixelCursor, PixelPattern, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_stratum, RenderingSpace, SamplePoint};
@@ -85,6 +85,18 @@ impl StratifiedSampler {
             seed,
         }
     }
+}
+
+impl PixelPattern for StratifiedSampler {
+    const NAME: &'static str = "stratified";
+
+    fn cursor(&self) -> &PixelCursor {
+        &self.cursor
+    }
+
+    fn cursor_mut(&mut self) -> &mut PixelCursor {
+        &mut self.cursor
+    }
 
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
         let dims = self.cursor.space().dims;
@@ -132,32 +144,6 @@ impl StratifiedSampler {
                 lens,
             });
         }
-    }
-}
-
-impl Sampler for StratifiedSampler {
-    fn name(&self) -> &'static str {
-        "stratified"
-    }
-
-    fn spp(&self) -> u32 {
-        self.xsamples * self.ysamples
-    }
-
-    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        out.clear();
-        let Some((pixels, indices)) = self.cursor.next() else {
-            return false;
-        };
-        for i in pixels {
-            let p = self.cursor.space().pixel(i);
-            self.pixel(p, indices.clone(), out);
-        }
-        true
-    }
-
-    fn halt(&mut self) {
-        self.cursor.halt();
     }
 }
 
