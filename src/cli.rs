@@ -233,15 +233,11 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     }
     let t_rendered = Instant::now();
 
-    let pixels = plugins
-        .filter
-        .reconstruct(&film, plugins.sampler.partition());
     let (w, h) = scene.film.size();
-    let scale = scene.film.scale;
     let image = RgbImage {
         width: w as usize,
         height: h as usize,
-        pixels: pixels.into_iter().map(|c| c * scale).collect(),
+        pixels: plugins.image(&film),
     };
     let t_reconstructed = Instant::now();
     write_image(&output, &image).map_err(|e| format!("{}: {e}", output.display()))?;

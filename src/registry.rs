@@ -2,11 +2,13 @@
 //! integrators from here), and the choice of the three plugins of a render: the scene's
 //! directives, overridden by the command line.
 
+use crate::geometry::Spectrum;
 use crate::integrator::{Integrator, IntegratorBuild, INTEGRATORS};
 use acr_parser::{Result, SceneDescription, Warning};
 use acr_plugins::filters::FilterBuild;
 use acr_plugins::registry::{check_params, lookup};
 use acr_plugins::sampler::SamplerBuild;
+use acr_plugins::Film;
 use acr_plugins::{Choice, Entry, Filter, Kind, PluginInfo, Sampler, SamplerSetup, Setting};
 use acr_plugins::{FILTERS, SAMPLERS};
 
@@ -39,6 +41,19 @@ pub struct Plugins {
     pub filter: Box<dyn Filter>,
     /// What each sample estimates.
     pub integrator: Integrator,
+}
+
+impl Plugins {
+    /// The image from `film`: the filter's reconstruction, with the sampler's partition when it
+    /// has one, times the film's `scale`; row-major over the cropped film.
+    pub fn image(&self, film: &Film) -> Vec<Spectrum> {
+        let scale = film.settings().scale;
+        self.filter
+            .reconstruct(film, self.sampler.partition())
+            .into_iter()
+            .map(|c| c * scale)
+            .collect()
+    }
 }
 
 /// Looks the choice up, applies the `--set`s of its kind and checks its parameters.

@@ -62,14 +62,8 @@ fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> Rendered {
         None,
         None,
     );
-    let scale = scene.film.scale;
     Rendered {
-        pixels: plugins
-            .filter
-            .reconstruct(&film, None)
-            .into_iter()
-            .map(|c| c * scale)
-            .collect(),
+        pixels: plugins.image(&film),
         width: scene.film.size().0 as usize,
         dropped: counts.dropped,
     }
