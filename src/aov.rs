@@ -1,15 +1,17 @@
 //! Arbitrary output variables (`--aov NAME=FILE`): per-pixel images beside the render. `spp` is
 //! the number of samples each pixel received, `variance` the variance of each pixel's mean.
 //! An `.exr` (or `.pfm`) holds the values themselves; a `.png` a false-colour picture scaled
-//! by the largest value, which is written into the PNG (a tEXt chunk) and printed.
+//! by the largest value, which is written into the PNG (a tEXt chunk) and printed. `clusters`
+//! is the cluster sampler's final partition: in a PNG each cluster a colour with its borders
+//! drawn dark (the paper's figures 2 and 4), in an EXR each pixel's cluster id.
 
 use crate::geometry::Spectrum;
 use crate::image_io::{write_image, RgbImage};
-use acr_plugins::PixelStats;
+use acr_plugins::{Partition, PixelStats};
 use std::path::{Path, PathBuf};
 
 /// The AOVs acr writes.
-pub const AOV_NAMES: &[&str] = &["spp", "variance"];
+pub const AOV_NAMES: &[&str] = &["spp", "variance", "clusters"];
 
 /// One requested AOV.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -65,7 +67,12 @@ pub fn write_aov(
     width: usize,
     height: usize,
     stats: &[PixelStats],
+    partition: Option<&Partition>,
 ) -> Result<String, String> {
+    if req.name == "clusters" {
+        let p = partition.ok_or("--aov clusters: the sampler made no clusters")?;
+        return write_clusters(req, p);
+    }
     let values = aov_values(&req.name, stats);
     let ext = req
         .path
@@ -112,6 +119,79 @@ pub fn write_aov(
     ))
 }
 
+/// A colour for cluster `id`: hue from a hash of the id, bright enough to show dark borders.
+pub fn cluster_colour(id: u32) -> [u8; 3] {
+    let h = acr_plugins::rng::mix64(u64::from(id) ^ 0x5eed);
+    let hue = (h % 3600) as f32 / 600.0;
+    let (sat, val) = (
+        0.45 + (h >> 20 & 0xff) as f32 / 255.0 * 0.5,
+        0.75 + (h >> 28 & 0xff) as f32 / 255.0 * 0.25,
+    );
+    let c = val * sat;
+    let x = c * (1.0 - (hue % 2.0 - 1.0).abs());
+    let (r, g, b) = match hue as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = val - c;
+    [r, g, b].map(|v| ((v + m) * 255.0 + 0.5) as u8)
+}
+
+/// Writes the partition: a PNG of cluster colours with borders, or the ids as values.
+fn write_clusters(req: &AovRequest, p: &Partition) -> Result<String, String> {
+    let (w, h) = (p.width as usize, p.height as usize);
+    let ext = req
+        .path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let count = p.clusters();
+    if ext != "png" {
+        let pixels = p
+            .cluster
+            .iter()
+            .map(|&c| Spectrum::splat(c as f32))
+            .collect();
+        write_image(
+            &req.path,
+            &RgbImage {
+                width: w,
+                height: h,
+                pixels,
+            },
+        )
+        .map_err(|e| format!("{}: {e}", req.path.display()))?;
+        return Ok(format!(
+            "clusters AOV -> {}: {count} cluster ids",
+            req.path.display()
+        ));
+    }
+    let mut bytes = Vec::with_capacity(3 * w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let c = p.cluster[y * w + x];
+            // A pixel on a border with its right or lower neighbour is drawn dark.
+            let border = (x + 1 < w && p.cluster[y * w + x + 1] != c)
+                || (y + 1 < h && p.cluster[(y + 1) * w + x] != c);
+            let rgb = if border {
+                cluster_colour(c).map(|v| v / 4)
+            } else {
+                cluster_colour(c)
+            };
+            bytes.extend_from_slice(&rgb);
+        }
+    }
+    let text = format!("{count} clusters, borders dark");
+    write_png(&req.path, w, h, &bytes, &text)
+        .map_err(|e| format!("{}: {e}", req.path.display()))?;
+    Ok(format!("clusters AOV -> {}: {text}", req.path.display()))
+}
+
 /// The false-colour map: black, blue, magenta, orange, yellow, white (like "inferno"), at
 /// `t` in [0, 1].
 pub fn false_colour(t: f32) -> [u8; 3] {
@@ -148,6 +228,17 @@ fn write_false_colour(
         let t = if max > 0.0 { v / max } else { 0.0 };
         bytes.extend_from_slice(&false_colour(t));
     }
+    write_png(path, width, height, &bytes, scale)
+}
+
+/// An 8-bit RGB PNG with an `acr-scale` tEXt chunk saying what the colours mean.
+fn write_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    bytes: &[u8],
+    scale: &str,
+) -> Result<(), String> {
     let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
     let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width as u32, height as u32);
     enc.set_color(png::ColorType::Rgb);
@@ -155,7 +246,7 @@ fn write_false_colour(
     enc.add_text_chunk("acr-scale".to_owned(), scale.to_owned())
         .map_err(|e| e.to_string())?;
     let mut w = enc.write_header().map_err(|e| e.to_string())?;
-    w.write_image_data(&bytes).map_err(|e| e.to_string())?;
+    w.write_image_data(bytes).map_err(|e| e.to_string())?;
     w.finish().map_err(|e| e.to_string())
 }
 
@@ -173,6 +264,17 @@ mod tests {
         assert!(e.contains("did you mean \"spp\""), "{e}");
         assert!(parse_aovs("spp").is_err());
         assert!(parse_aovs("spp=").is_err());
+    }
+
+    #[test]
+    fn cluster_colours_differ_and_show_borders() {
+        let colours: std::collections::HashSet<[u8; 3]> = (0..64).map(cluster_colour).collect();
+        assert!(colours.len() >= 60);
+        for id in 0..64 {
+            let c = cluster_colour(id);
+            // Bright: a border at a quarter of it stands out.
+            assert!(c.iter().copied().max().unwrap_or(0) >= 180, "{id}: {c:?}");
+        }
     }
 
     #[test]

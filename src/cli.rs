@@ -203,6 +203,12 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         .collect();
     for a in &aovs {
         check_writable(&a.path)?;
+        if a.name == "clusters" && plugins.sampler.report().cells.is_none() {
+            return Err(format!(
+                "--aov clusters: the {} sampler makes no clusters (use --sampler cluster)",
+                plugins.sampler.name()
+            ));
+        }
     }
     let t_built = Instant::now();
 
@@ -242,7 +248,13 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     let t_reconstructed = Instant::now();
     write_image(&output, &image).map_err(|e| format!("{}: {e}", output.display()))?;
     for a in &aovs {
-        let line = write_aov(a, w as usize, h as usize, film.pixel_stats())?;
+        let line = write_aov(
+            a,
+            w as usize,
+            h as usize,
+            film.pixel_stats(),
+            plugins.sampler.partition(),
+        )?;
         if !args.quiet {
             eprintln!("{line}");
         }
@@ -250,6 +262,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     let t_written = Instant::now();
 
     let render_s = (t_rendered - t_built).as_secs_f64();
+    let report = plugins.sampler.report();
     let stats = Stats {
         scene: args.scene.display().to_string(),
         width: w,
@@ -264,12 +277,15 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         integrator: plugins.integrator.name().into(),
         halted: counts.halted,
         dims: scene.dims.names().into_iter().map(str::to_owned).collect(),
-        clusters: None,
+        clusters: report.clusters,
+        cells: report.cells,
+        rounds: report.rounds,
         dropped_samples: counts.dropped,
         seconds: Seconds {
             parse: (t_parsed - t_start).as_secs_f64(),
             build: (t_built - t_parsed).as_secs_f64(),
             render: render_s,
+            sampler: counts.sampler_seconds,
             reconstruct: (t_reconstructed - t_rendered).as_secs_f64(),
             write: (t_written - t_reconstructed).as_secs_f64(),
             total: t_start.elapsed().as_secs_f64(),

@@ -46,6 +46,8 @@ pub struct RenderCounts {
     pub dropped: u64,
     /// The time limit stopped the render before the sampler's budget was spent.
     pub halted: bool,
+    /// Wall seconds spent in the sampler (its batches and what it learns from them).
+    pub sampler_seconds: f64,
 }
 
 /// Renders `scene` with `sampler`'s points into `film`, until the sampler's budget is spent
@@ -71,7 +73,14 @@ pub fn render(
     let mut results: Vec<(Spectrum, u32)> = Vec::new();
     let mut radiance: Vec<[f32; 3]> = Vec::new();
     let mut valid: Vec<(Vec2, Spectrum)> = Vec::new();
-    while sampler.next_batch(&mut batch) {
+    let mut in_sampler = Duration::ZERO;
+    loop {
+        let t = Instant::now();
+        let more = sampler.next_batch(&mut batch);
+        in_sampler += t.elapsed();
+        if !more {
+            break;
+        }
         batch
             .par_iter()
             .map(|q| {
@@ -100,7 +109,9 @@ pub fn render(
                 radiance.push([f32::NAN; 3]);
             }
         }
+        let t = Instant::now();
         sampler.observe(&batch, &radiance);
+        in_sampler += t.elapsed();
         film.add_samples(&valid);
         counts.samples += batch.len() as u64;
         if let Some(p) = progress {
@@ -111,5 +122,6 @@ pub fn render(
         }
     }
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
+    counts.sampler_seconds = in_sampler.as_secs_f64();
     counts
 }

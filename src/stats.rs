@@ -9,8 +9,10 @@ pub struct Seconds {
     pub parse: f64,
     /// Building the scene (BVH, lights, materials, textures).
     pub build: f64,
-    /// Tracing samples.
+    /// Tracing samples (the sampler's time included).
     pub render: f64,
+    /// Of the render, the time spent in the sampler choosing points and learning from them.
+    pub sampler: f64,
     /// Reconstructing the image from the film.
     pub reconstruct: f64,
     /// Writing output files.
@@ -50,6 +52,10 @@ pub struct Stats {
     pub halted: bool,
     /// Clusters of the cluster sampler (null for other samplers).
     pub clusters: Option<u64>,
+    /// Cells of the cluster sampler's grid (null for other samplers).
+    pub cells: Option<u64>,
+    /// Adaptive rounds of the cluster sampler (null for other samplers).
+    pub rounds: Option<u64>,
     /// Samples dropped for NaN, infinite or negative radiance.
     pub dropped_samples: u64,
     /// Time per phase.

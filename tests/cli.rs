@@ -900,7 +900,7 @@ fn a_time_limit_stops_at_a_whole_pass_and_the_image_stays_complete() {
 fn every_sampler_gives_the_same_file_with_one_and_two_threads() {
     let dir = TempDir::new("samplers");
     let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 20, 14));
-    for sampler in ["random", "stratified", "halton", "sobol"] {
+    for sampler in ["random", "stratified", "halton", "sobol", "cluster"] {
         let run = |threads: &str| {
             let out = dir.join(format!("{sampler}{threads}.exr"));
             render_ok(
@@ -912,6 +912,99 @@ fn every_sampler_gives_the_same_file_with_one_and_two_threads() {
         };
         assert!(run("1") == run("2"), "{sampler}: 1 and 2 threads differ");
     }
+}
+
+#[test]
+fn the_cluster_sampler_reports_clusters_and_draws_them() {
+    let dir = TempDir::new("cluster");
+    let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 40, 30));
+    let (out, stats, clusters, ids, spp) = (
+        dir.join("c.exr"),
+        dir.join("c.json"),
+        dir.join("clusters.png"),
+        dir.join("clusters.exr"),
+        dir.join("spp.exr"),
+    );
+    let aov = format!("clusters={},spp={}", clusters.display(), spp.display());
+    let o = render_ok(
+        &scene,
+        &out,
+        &[
+            "--spp",
+            "8",
+            "--sampler",
+            "cluster",
+            "--set",
+            "sampler.bins=2",
+            "--filter",
+            "gaussian",
+            "--stats",
+            stats.to_str().unwrap(),
+            "--aov",
+            &aov,
+            "--aov",
+            &format!("clusters={}", ids.display()),
+        ],
+    );
+    let _ = o;
+    let s = read_stats(&stats);
+    let n = |k: &str| s[k].as_u64().unwrap_or_else(|| panic!("{k}: {s}"));
+    // 40 x 30 pixels, 8 cells each (t, u, v in two bins).
+    assert_eq!(n("cells"), 40 * 30 * 8);
+    assert!(n("clusters") > 1 && n("clusters") < n("cells"), "{s}");
+    assert!(n("rounds") >= 1);
+    assert_eq!(n("samples"), 40 * 30 * 8, "the budget, spent exactly");
+    let sampler_s = s["seconds"]["sampler"].as_f64().unwrap();
+    assert!(sampler_s > 0.0 && sampler_s <= s["seconds"]["render"].as_f64().unwrap());
+    // The samples went unevenly, never below one per pixel, 8 on average.
+    let counts = read_image(&spp, false).unwrap();
+    let (lo, hi) = counts
+        .pixels
+        .iter()
+        .fold((f32::MAX, 0.0f32), |(a, b), c| (a.min(c.x), b.max(c.x)));
+    assert!(lo >= 1.0 && hi > 8.0, "spp from {lo} to {hi}");
+    // The partition: cluster ids in the EXR, colours with dark borders in the PNG.
+    let ids = read_image(&ids, false).unwrap();
+    let distinct: std::collections::HashSet<u32> = ids.pixels.iter().map(|c| c.x as u32).collect();
+    assert!(distinct.len() > 1);
+    let png = image::open(&clusters).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (40, 30));
+    let colours: std::collections::HashSet<[u8; 3]> = png.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 2, "{} colours", colours.len());
+    // Another sampler has no clusters to draw: refused before rendering.
+    let o = acr_command([
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.join("x.exr").to_str().unwrap(),
+        "--sampler",
+        "sobol",
+        "--aov",
+        &format!("clusters={}", clusters.display()),
+    ])
+    .output()
+    .unwrap();
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("makes no clusters"), "{}", stderr(&o));
+    // A knob out of range is a located error.
+    let o = acr_command([
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.join("x.exr").to_str().unwrap(),
+        "--sampler",
+        "cluster",
+        "--set",
+        "sampler.omega=-1",
+    ])
+    .output()
+    .unwrap();
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("omega -1 is out of range"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]

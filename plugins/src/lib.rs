@@ -2,6 +2,7 @@
 //! filters, over the abstract rendering space. Nothing here knows about geometry, so every
 //! plugin is testable on analytic integrands.
 
+pub mod cluster;
 pub mod film;
 pub mod filters;
 pub mod partition;

@@ -64,9 +64,69 @@ impl<K: FilterKernel> Filter for Splatting<K> {
         &self.kernel
     }
 
-    fn reconstruct(&self, film: &Film, _partition: Option<&Partition>) -> Vec<Spectrum> {
-        film.pixels()
+    fn reconstruct(&self, film: &Film, partition: Option<&Partition>) -> Vec<Spectrum> {
+        match partition {
+            // An adaptive sampler spread its samples unevenly over the image.
+            Some(_) => filter_pixel_means(film, &self.kernel),
+            None => film.pixels(),
+        }
     }
+}
+
+/// The image from each pixel's own mean, filtered with `kernel` at pixel-centre offsets. Used
+/// after an adaptive sampler: splatting weighs every sample alike, so a pixel with 60 samples
+/// would outweigh a neighbour with 4 under a wide kernel and pull it toward its own value
+/// (measured on motion-blur-3d at 16 spp: 4x stratified+gaussian's MSE when splatted). For
+/// the box filter of radius 0.5 it is the splatted image itself.
+pub fn filter_pixel_means(film: &Film, kernel: &dyn FilterKernel) -> Vec<Spectrum> {
+    use rayon::prelude::*;
+    let (w, h) = film.settings().size();
+    let (w, h) = (w as i64, h as i64);
+    let stats = film.pixel_stats();
+    let (rx, ry) = kernel.radius();
+    let mut taps = Vec::new();
+    for dy in -(ry.floor() as i64)..=ry.floor() as i64 {
+        for dx in -(rx.floor() as i64)..=rx.floor() as i64 {
+            let k = kernel.eval(dx as f32, dy as f32);
+            if k != 0.0 {
+                taps.push((dx, dy, f64::from(k)));
+            }
+        }
+    }
+    (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let (taps, stats) = (&taps, stats);
+            (0..w).map(move |x| {
+                let (mut sum, mut weight) = ([0.0f64; 3], 0.0f64);
+                for &(dx, dy, k) in taps {
+                    let (qx, qy) = (x + dx, y + dy);
+                    if qx < 0 || qy < 0 || qx >= w || qy >= h {
+                        continue;
+                    }
+                    let s = &stats[(qy * w + qx) as usize];
+                    if s.count == 0 {
+                        continue;
+                    }
+                    let inv = 1.0 / f64::from(s.count);
+                    for (acc, v) in sum.iter_mut().zip(s.sum) {
+                        *acc += k * v * inv;
+                    }
+                    weight += k;
+                }
+                if weight == 0.0 {
+                    return Spectrum::ZERO;
+                }
+                // Negative lobes (Mitchell, sinc) can make a mean slightly negative.
+                Spectrum::new(
+                    (sum[0] / weight) as f32,
+                    (sum[1] / weight) as f32,
+                    (sum[2] / weight) as f32,
+                )
+                .max(Spectrum::ZERO)
+            })
+        })
+        .collect()
 }
 
 /// Builds a filter from its checked parameters.
@@ -152,6 +212,37 @@ mod tests {
             }
             assert!(integral(k) > 0.0);
         }
+    }
+
+    #[test]
+    fn pixel_means_filtered_ignore_sample_counts() {
+        use crate::film::FilmSettings;
+        use glam::Vec2;
+        // Two pixels, one with 60 samples of 1, one with 4 samples of 0: a wide gaussian
+        // splat leans toward the crowded pixel, the filtered means weigh the pixels alike.
+        let g = GaussianFilter::new(2.0, 2.0, 2.0);
+        let mut film = Film::new(FilmSettings::with_resolution(2, 1), &g);
+        let mut samples = Vec::new();
+        for i in 0..60 {
+            samples.push((Vec2::new(0.05 + i as f32 * 0.015, 0.5), Spectrum::ONE));
+        }
+        for i in 0..4 {
+            samples.push((Vec2::new(1.1 + i as f32 * 0.2, 0.5), Spectrum::ZERO));
+        }
+        film.add_samples(&samples);
+        let splat = film.pixels();
+        let means = filter_pixel_means(&film, &g);
+        let k = f64::from(g.eval(1.0, 0.0)) / f64::from(g.eval(0.0, 0.0));
+        assert!(
+            (f64::from(means[1].x) - k / (1.0 + k)).abs() < 1e-5,
+            "{means:?}"
+        );
+        assert!(splat[1].x > means[1].x + 0.2, "{splat:?} vs {means:?}");
+        // The box filter of radius 0.5: the splat itself.
+        let b = BoxFilter::new(0.5, 0.5);
+        let mut film = Film::new(FilmSettings::with_resolution(2, 1), &b);
+        film.add_samples(&samples);
+        assert_eq!(filter_pixel_means(&film, &b), film.pixels());
     }
 
     #[test]

@@ -2,11 +2,13 @@
 //! row-major order. Every sampler is deterministic in (space, spp, seed) and keeps no global
 //! state, so an image does not depend on the thread count. A new sampler is one file here.
 
+mod cluster;
 mod halton;
 mod random;
 mod sobol;
 mod stratified;
 
+pub use cluster::{ClusterSampler, ClusterSettings, Priority};
 pub use halton::HaltonSampler;
 pub use random::RandomSampler;
 pub use sobol::{SobolSampler, SOBOL_DIMS_USED, SOBOL_SAMPLES};
@@ -50,6 +52,22 @@ pub trait Sampler: Send {
     fn partition(&self) -> Option<&Partition> {
         None
     }
+
+    /// What the sampler reports for the stats file (nothing, for a non-adaptive sampler).
+    fn report(&self) -> SamplerReport {
+        SamplerReport::default()
+    }
+}
+
+/// An adaptive sampler's figures for the stats file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SamplerReport {
+    /// Clusters at the end.
+    pub clusters: Option<u64>,
+    /// Cells of its grid.
+    pub cells: Option<u64>,
+    /// Adaptive rounds run.
+    pub rounds: Option<u64>,
 }
 
 /// What every sampler is built for: the space, the command line's `--spp` and the seed.
@@ -72,6 +90,7 @@ pub static SAMPLERS: &[Entry<SamplerBuild>] = &[
     stratified::ENTRY,
     halton::ENTRY,
     sobol::ENTRY,
+    cluster::ENTRY,
 ];
 
 /// The `pixelsamples` parameter, or the command line's `--spp`, checked to lie in 1..=MAX_SPP.

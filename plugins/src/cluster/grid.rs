@@ -1,0 +1,430 @@
+//! The cell grid over the active dims (ALGORITHM.md section 2) and each cell's running sums.
+//! Image dims are cut every `cellsize` pixels, each non-image dim into `bins` intervals; the
+//! non-image dims are innermost in the cell index, so a pixel's cells lie together in memory.
+
+use crate::film::{luminance, Spectrum};
+use crate::space::{in_pixel, RenderingSpace, SamplePoint};
+
+/// Most active dims: x, y, t, u, v.
+pub const MAX_DIMS: usize = 5;
+
+/// Integer coordinates of a cell, one per active dim (unused entries 0).
+pub type Coords = [u32; MAX_DIMS];
+
+/// The grid of cells over a rendering space.
+#[derive(Clone, Debug)]
+pub struct CellGrid {
+    space: RenderingSpace,
+    cell_size: f64,
+    n: usize,
+    shape: Coords,
+    stride: [usize; MAX_DIMS],
+    len: usize,
+}
+
+impl CellGrid {
+    /// Cells of `cell_size` pixels in x and y and `bins` intervals per non-image dim.
+    pub fn new(space: RenderingSpace, cell_size: f64, bins: u32) -> Self {
+        let n = space.dims.count();
+        let along = |w: u32| ((f64::from(w) / cell_size).ceil() as u32).max(1);
+        let mut shape = [1; MAX_DIMS];
+        shape[0] = along(space.width());
+        shape[1] = along(space.height());
+        for s in &mut shape[2..n] {
+            *s = bins.max(1);
+        }
+        let inner: usize = shape[2..n].iter().map(|&b| b as usize).product();
+        let mut stride = [0; MAX_DIMS];
+        stride[0] = inner;
+        stride[1] = inner * shape[0] as usize;
+        let mut s = 1;
+        for d in 2..n {
+            stride[d] = s;
+            s *= shape[d] as usize;
+        }
+        Self {
+            space,
+            cell_size,
+            n,
+            shape,
+            stride,
+            len: stride[1] * shape[1] as usize,
+        }
+    }
+
+    /// The space the grid covers.
+    pub fn space(&self) -> &RenderingSpace {
+        &self.space
+    }
+
+    /// How many cells.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the grid has no cell (never: an empty space still has one).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Active dims.
+    pub fn dims(&self) -> usize {
+        self.n
+    }
+
+    /// Cells along each active dim.
+    pub fn shape(&self) -> &[u32] {
+        &self.shape[..self.n]
+    }
+
+    /// Cells that share one image cell (the product of the non-image bins).
+    pub fn cells_per_image_cell(&self) -> usize {
+        self.stride[0]
+    }
+
+    /// Pixels per image cell side.
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+
+    /// The coordinates of cell `i`.
+    #[inline]
+    pub fn coords(&self, i: usize) -> Coords {
+        let mut c = [0; MAX_DIMS];
+        let image = i / self.stride[0];
+        c[0] = (image % self.shape[0] as usize) as u32;
+        c[1] = (image / self.shape[0] as usize) as u32;
+        let mut inner = i % self.stride[0];
+        for (cd, &len) in c[2..self.n].iter_mut().zip(&self.shape[2..self.n]) {
+            *cd = (inner % len as usize) as u32;
+            inner /= len as usize;
+        }
+        c
+    }
+
+    /// The index of the cell at `c`.
+    #[inline]
+    pub fn index(&self, c: &Coords) -> usize {
+        (0..self.n).map(|d| c[d] as usize * self.stride[d]).sum()
+    }
+
+    /// The neighbour of cell `i` one step along `dim` (`up` or down), if inside the grid.
+    #[inline]
+    pub fn step(&self, i: usize, c: &Coords, dim: usize, up: bool) -> Option<usize> {
+        if up {
+            (c[dim] + 1 < self.shape[dim]).then(|| i + self.stride[dim])
+        } else {
+            (c[dim] > 0).then(|| i - self.stride[dim])
+        }
+    }
+
+    /// Appends the face neighbours of cell `i` (two per dim, fewer at the border).
+    pub fn neighbours(&self, i: usize, out: &mut Vec<usize>) {
+        let c = self.coords(i);
+        for d in 0..self.n {
+            for up in [false, true] {
+                if let Some(j) = self.step(i, &c, d, up) {
+                    out.push(j);
+                }
+            }
+        }
+    }
+
+    /// A point's coordinates in the active dims: pixels from the space's corner in x and y,
+    /// then t, u, v in [0, 1).
+    #[inline]
+    fn position(&self, q: &SamplePoint) -> [f64; MAX_DIMS] {
+        let mut p = [0.0; MAX_DIMS];
+        p[0] = f64::from(q.film[0]) - f64::from(self.space.x0);
+        p[1] = f64::from(q.film[1]) - f64::from(self.space.y0);
+        let mut d = 2;
+        if self.space.dims.time {
+            p[d] = f64::from(q.time);
+            d += 1;
+        }
+        if self.space.dims.lens {
+            p[d] = f64::from(q.lens[0]);
+            p[d + 1] = f64::from(q.lens[1]);
+        }
+        p
+    }
+
+    /// The extent of cell coordinate `k` along `dim`, in the units of [`Self::position`].
+    #[inline]
+    fn extent(&self, dim: usize, k: u32) -> (f64, f64) {
+        if dim < 2 {
+            let limit = f64::from(if dim == 0 {
+                self.space.width()
+            } else {
+                self.space.height()
+            });
+            let lo = f64::from(k) * self.cell_size;
+            (lo, (lo + self.cell_size).min(limit))
+        } else {
+            let b = f64::from(self.shape[dim]);
+            (f64::from(k) / b, f64::from(k + 1) / b)
+        }
+    }
+
+    /// The cell coordinate along `dim` of position `v` (in the units of [`Self::position`]).
+    #[inline]
+    fn coord(&self, dim: usize, v: f64) -> u32 {
+        let unit = if dim < 2 {
+            self.cell_size
+        } else {
+            1.0 / f64::from(self.shape[dim])
+        };
+        ((v / unit).floor().max(0.0) as u32).min(self.shape[dim] - 1)
+    }
+
+    /// The cell a point lies in and its offsets inside the cell, each in [0, 1).
+    #[inline]
+    pub fn locate(&self, q: &SamplePoint) -> (usize, [f32; MAX_DIMS]) {
+        let p = self.position(q);
+        let mut c = [0; MAX_DIMS];
+        let mut off = [0.0; MAX_DIMS];
+        for d in 0..self.n {
+            let k = self.coord(d, p[d]);
+            let (lo, hi) = self.extent(d, k);
+            c[d] = k;
+            off[d] = (((p[d] - lo) / (hi - lo)) as f32).clamp(0.0, crate::space::ONE_MINUS_EPSILON);
+        }
+        (self.index(&c), off)
+    }
+
+    /// The sample point at offsets `u` (each in [0, 1)) inside cell `i`; its pixel is where it
+    /// falls, its index is left 0 for the caller.
+    pub fn point(&self, i: usize, u: &[f32; MAX_DIMS]) -> SamplePoint {
+        let c = self.coords(i);
+        let mut p = [0.5f64; MAX_DIMS];
+        for d in 0..self.n {
+            let (lo, hi) = self.extent(d, c[d]);
+            p[d] = lo + f64::from(u[d]) * (hi - lo);
+        }
+        // The raster coordinate in f32, nudged by ulps where rounding carried it out of the
+        // cell (10 + 0.49999997 rounds to 10.5): a point lies in the cell it was drawn for, as
+        // `locate` sees it.
+        let film_axis = |d: usize, origin: u32, limit: u32| {
+            let v = p[d];
+            let k = (v.floor().max(0.0) as u32).min(limit.saturating_sub(1));
+            let px = origin + k;
+            let mut f = in_pixel(px, (v - f64::from(k)).clamp(0.0, 1.0) as f32);
+            for _ in 0..8 {
+                let got = self.coord(d, f64::from(f) - f64::from(origin));
+                let up = f32::from_bits(f.to_bits() + 1);
+                if got > c[d] && f > px as f32 {
+                    f = f32::from_bits(f.to_bits() - 1);
+                } else if got < c[d] && f64::from(up) < f64::from(px) + 1.0 {
+                    f = up;
+                } else {
+                    break;
+                }
+            }
+            (px, f)
+        };
+        let (px, fx) = film_axis(0, self.space.x0, self.space.width());
+        let (py, fy) = film_axis(1, self.space.y0, self.space.height());
+        let clamp01 = |v: f64| (v as f32).min(crate::space::ONE_MINUS_EPSILON);
+        let mut d = 2;
+        let time = if self.space.dims.time {
+            d += 1;
+            clamp01(p[2])
+        } else {
+            0.5
+        };
+        let lens = if self.space.dims.lens {
+            [clamp01(p[d]), clamp01(p[d + 1])]
+        } else {
+            [0.5; 2]
+        };
+        SamplePoint {
+            pixel: [px, py],
+            index: 0,
+            film: [fx, fy],
+            time,
+            lens,
+        }
+    }
+
+    /// The pixel of the point at offsets `u` inside cell `i` (what [`Self::point`] would give,
+    /// without the rest of the point).
+    #[inline]
+    pub fn pixel(&self, i: usize, u: &[f32; MAX_DIMS]) -> [u32; 2] {
+        let image = i / self.stride[0];
+        let c = [
+            image % self.shape[0] as usize,
+            image / self.shape[0] as usize,
+        ];
+        let limit = [self.space.width(), self.space.height()];
+        let origin = [self.space.x0, self.space.y0];
+        std::array::from_fn(|d| {
+            let (lo, hi) = self.extent(d, c[d] as u32);
+            let v = lo + f64::from(u[d]) * (hi - lo);
+            origin[d] + (v.floor().max(0.0) as u32).min(limit[d].saturating_sub(1))
+        })
+    }
+
+    /// The image cell (x, y cell coordinates) holding the centre of pixel `(px, py)`, given
+    /// relative to the space's corner.
+    pub fn image_cell_of_pixel(&self, px: u32, py: u32) -> (u32, u32) {
+        let at = |p: u32, d: usize| {
+            ((((f64::from(p) + 0.5) / self.cell_size).floor()) as u32).min(self.shape[d] - 1)
+        };
+        (at(px, 0), at(py, 1))
+    }
+}
+
+/// Each cell's running sums (never its samples), structure of arrays.
+#[derive(Clone, Debug, Default)]
+pub struct CellSums {
+    /// Samples in the cell.
+    pub count: Vec<u32>,
+    /// Sum of radiance per channel.
+    pub rgb: Vec<[f32; 3]>,
+    /// Sum of squared radiance per channel.
+    pub rgb_sq: Vec<[f32; 3]>,
+    /// Sum of luminance (f64: the variance subtracts squares of it).
+    pub lum: Vec<f64>,
+    /// Sum of squared luminance.
+    pub lum_sq: Vec<f64>,
+    /// Sum of the samples' offsets inside the cell, `dims` per cell, for their centroid.
+    pub offset: Vec<f32>,
+    dims: usize,
+}
+
+impl CellSums {
+    /// Zeroed sums for every cell of `grid`.
+    pub fn new(grid: &CellGrid) -> Self {
+        let n = grid.len();
+        Self {
+            count: vec![0; n],
+            rgb: vec![[0.0; 3]; n],
+            rgb_sq: vec![[0.0; 3]; n],
+            lum: vec![0.0; n],
+            lum_sq: vec![0.0; n],
+            offset: vec![0.0; n * grid.dims()],
+            dims: grid.dims(),
+        }
+    }
+
+    /// Adds one sample of radiance `l` at offsets `off` to cell `i`.
+    #[inline]
+    pub fn add(&mut self, i: usize, off: &[f32; MAX_DIMS], l: Spectrum) {
+        self.count[i] += 1;
+        let y = f64::from(luminance(l));
+        self.lum[i] += y;
+        self.lum_sq[i] += y * y;
+        for (c, v) in [l.x, l.y, l.z].into_iter().enumerate() {
+            self.rgb[i][c] += v;
+            self.rgb_sq[i][c] += v * v;
+        }
+        for (s, o) in self.offset[i * self.dims..][..self.dims]
+            .iter_mut()
+            .zip(off)
+        {
+            *s += o;
+        }
+    }
+
+    /// The mean luminance of cell `i`, if it has samples.
+    #[inline]
+    pub fn mean(&self, i: usize) -> Option<f64> {
+        let n = self.count[i];
+        (n > 0).then(|| self.lum[i] / f64::from(n))
+    }
+
+    /// The sample variance of luminance in cell `i` (N - 1 in the denominator; 0 when N < 2).
+    #[inline]
+    pub fn variance(&self, i: usize) -> f64 {
+        let n = f64::from(self.count[i]);
+        if n < 2.0 {
+            return 0.0;
+        }
+        ((self.lum_sq[i] - self.lum[i] * self.lum[i] / n) / (n - 1.0)).max(0.0)
+    }
+
+    /// Bytes held, for the memory budget.
+    pub fn bytes(&self) -> usize {
+        self.count.capacity() * 4
+            + self.rgb.capacity() * 12
+            + self.rgb_sq.capacity() * 12
+            + self.lum.capacity() * 8
+            + self.lum_sq.capacity() * 8
+            + self.offset.capacity() * 4
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::space::Dims;
+
+    fn space(w: u32, h: u32, time: bool, lens: bool) -> RenderingSpace {
+        RenderingSpace {
+            x0: 10,
+            x1: 10 + w,
+            y0: 20,
+            y1: 20 + h,
+            dims: Dims { time, lens },
+        }
+    }
+
+    #[test]
+    fn indices_and_coords_round_trip() {
+        let g = CellGrid::new(space(7, 5, true, true), 1.0, 3);
+        assert_eq!(g.shape(), [7, 5, 3, 3, 3]);
+        assert_eq!(g.len(), 7 * 5 * 27);
+        for i in 0..g.len() {
+            assert_eq!(g.index(&g.coords(i)), i);
+        }
+        // A pixel's cells are consecutive.
+        assert_eq!(g.coords(26)[..2], [0, 0]);
+        assert_eq!(g.coords(27)[..2], [1, 0]);
+    }
+
+    #[test]
+    fn points_fall_in_their_cells() {
+        for (cs, (w, h)) in [(1.0, (7, 5)), (0.5, (3, 3)), (2.0, (5, 3)), (1.5, (4, 4))] {
+            let g = CellGrid::new(space(w, h, true, false), cs, 2);
+            for i in 0..g.len() {
+                for u in [[0.0; 5], [0.5; 5], [crate::space::ONE_MINUS_EPSILON; 5]] {
+                    let q = g.point(i, &u);
+                    let (j, off) = g.locate(&q);
+                    assert_eq!(j, i, "cellsize {cs} cell {i} u {u:?} -> {q:?}");
+                    assert!(off.iter().all(|o| (0.0..1.0).contains(o)));
+                    for a in 0..2 {
+                        let f = f64::from(q.film[a]);
+                        assert!(f >= f64::from(q.pixel[a]) && f < f64::from(q.pixel[a]) + 1.0);
+                    }
+                    assert!(q.pixel[0] < 10 + w && q.pixel[1] < 20 + h);
+                    assert_eq!(g.pixel(i, &u), q.pixel);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn neighbours_stay_inside() {
+        let g = CellGrid::new(space(3, 2, false, true), 1.0, 2);
+        let mut v = Vec::new();
+        g.neighbours(0, &mut v);
+        // Corner cell: one neighbour per dim.
+        assert_eq!(v.len(), 4);
+        v.clear();
+        let mid = g.index(&[1, 0, 1, 0, 0]);
+        g.neighbours(mid, &mut v);
+        assert_eq!(v.len(), 5);
+    }
+
+    #[test]
+    fn variance_of_known_samples() {
+        let g = CellGrid::new(space(1, 1, false, false), 1.0, 2);
+        let mut s = CellSums::new(&g);
+        assert_eq!(s.mean(0), None);
+        for v in [1.0f32, 2.0, 3.0] {
+            s.add(0, &[0.5; 5], Spectrum::splat(v));
+        }
+        assert!((s.mean(0).unwrap() - 2.0).abs() < 1e-6);
+        assert!((s.variance(0) - 1.0).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,1097 @@
+//! `cluster`: the paper's adaptive sampler (ALGORITHM.md sections 1 to 4). It samples every
+//! pixel `initspp` times (Owen-scrambled Sobol, stratified in every dim), groups the cells of
+//! the rendering space into clusters by their features, then spends the rest of the budget in
+//! rounds: the clusters of highest priority get a few samples each, spread over their cells;
+//! the cells that received samples and their neighbours get new features, and cells that no
+//! longer fit their cluster move (the paper's table 1). Every decision is made on one thread
+//! in a fixed order, and the parallel parts compute pure functions of the cells, so the points
+//! and the image do not depend on the thread count.
+
+use super::{
+    mix64, Pcg32, PixelPattern, Sampler, SamplerBuild, SamplerReport, SamplerSetup, SobolSampler,
+    BATCH_SAMPLES,
+};
+use crate::cluster::clusters::{distance, UNASSIGNED};
+use crate::cluster::features::{level, raw};
+use crate::cluster::grid::MAX_DIMS;
+use crate::cluster::{CellGrid, CellSums, Cluster, Clustering, FeatureScale, Membership};
+use crate::film::Spectrum;
+use crate::partition::Partition;
+use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::space::{RenderingSpace, SamplePoint};
+use acr_parser::{Error, ParamList, ParamType, Result};
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Salt of this sampler's random streams.
+const SALT: u64 = 0x636c_7573;
+
+/// Fewest and most samples a chosen cluster gets at a time (the paper's "4-16").
+const CLUSTER_SAMPLES: (u64, u64) = (4, 16);
+
+/// Smallest round, in samples: enough to keep every thread busy.
+const MIN_ROUND: u64 = 4096;
+
+/// How the next clusters to sample are chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Priority {
+    /// Error per sample, err(Ω) × cells(Ω) / samples(Ω): a cluster whose error does not fall
+    /// when sampled cannot take every sample.
+    PerSample,
+    /// The paper's rule: the largest err(Ω).
+    Paper,
+}
+
+/// The cluster sampler's knobs (ALGORITHM.md; `acr plugins` lists them with their defaults).
+#[derive(Clone, Copy, Debug)]
+pub struct ClusterSettings {
+    /// Samples per pixel, on average: the budget is spp × pixels.
+    pub spp: u32,
+    /// ω of eq. 10: larger is stricter, so clusters are smaller.
+    pub omega: f64,
+    /// Pixels per image cell side (0.5 is the paper's quarter pixel).
+    pub cell_size: f64,
+    /// Intervals per non-image dim.
+    pub bins: u32,
+    /// Samples per pixel of the first, uniform stage.
+    pub init_spp: u32,
+    /// Fewest samples any pixel ends with.
+    pub min_spp: u32,
+    /// Most cells in one cluster.
+    pub max_cluster_cells: u32,
+    /// Weights of the gradient, variance, position and level parts of the feature distance.
+    pub weights: [f64; 4],
+    /// How clusters are chosen for sampling.
+    pub priority: Priority,
+    /// Keep each pixel's points evenly spread over the pixel and its time and lens dims (the
+    /// pixel's Owen-scrambled Sobol sequence, which the first stage started: however many
+    /// points a pixel ends with, they stay stratified), and adapt only how many points each
+    /// pixel gets. A splatting
+    /// filter weighs every point of a pixel alike, so points crowded into some cells would pull
+    /// the pixel toward those cells' radiance, and points drawn at random in a cell lose the
+    /// stratification a pixel's sequence has.
+    pub even_pixels: bool,
+    /// Log-compress g and s (ln(1 + x) after scaling), so that a few extreme cells do not
+    /// dominate the distances and the priority.
+    pub log_features: bool,
+}
+
+impl ClusterSettings {
+    /// The defaults for a budget of `spp` samples per pixel.
+    pub fn new(spp: u32) -> Self {
+        Self {
+            spp,
+            omega: 0.7,
+            cell_size: 1.0,
+            // ALGORITHM.md's default is 2. Measured with acr bench over the 3D, 4D and 5D
+            // scenes at 4, 8 and 16 spp (geometric mean of the MSE ratio to
+            // stratified+gaussian): bins 1 0.79 (worst case 0.93), 2 0.82 (1.22), 3 1.12
+            // (1.50); with a splatting filter, cells cut in time and lens hold one or two
+            // samples each and their features are mostly noise. bins 1 also has a quarter to
+            // an eighth of the cells, so the sampler costs less (5D, 8 spp: 35% of wall time
+            // against 53%).
+            bins: 1,
+            init_spp: (spp / 4).max(1),
+            min_spp: 1,
+            max_cluster_cells: 64,
+            // Measured with acr bench (docs/BENCHMARKS.md, "Cluster sampler knobs"): over
+            // motion-blur-3d, depth-of-field-4d and motion-dof-5d at 4, 8 and 16 spp, the
+            // geometric mean of the MSE ratio to stratified+gaussian fell from 0.98 at
+            // posweight 1 to 0.90 at 1/4, 0.86 at 1/16 and 0.83 at 1/64 (0.84 at 0);
+            // gradweight and varweight 1/4 or 4 moved it by -3% to +5%.
+            weights: [1.0, 1.0, 1.0 / 64.0, 1.0],
+            priority: Priority::PerSample,
+            even_pixels: true,
+            // Measured: geometric-mean MSE ratio 0.98 with, 1.07 without (posweight 1/4:
+            // 0.90 with, 0.99 without); motion-blur-3d at 16 spp 0.92 with, 1.38 without.
+            log_features: true,
+        }
+    }
+}
+
+/// A cluster in the priority queue; ties go to the lower id, so the order is total.
+#[derive(Clone, Copy, Debug)]
+struct Ranked {
+    priority: f64,
+    id: u32,
+    version: u32,
+}
+
+impl PartialEq for Ranked {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+
+impl Eq for Ranked {}
+
+impl PartialOrd for Ranked {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for Ranked {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.priority
+            .total_cmp(&o.priority)
+            .then(o.id.cmp(&self.id))
+            .then(self.version.cmp(&o.version))
+    }
+}
+
+/// Where the sampler is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    Init,
+    Adaptive,
+    Done,
+}
+
+/// The adaptive cluster sampler.
+pub struct ClusterSampler {
+    settings: ClusterSettings,
+    seed: u64,
+    space: RenderingSpace,
+    phase: Phase,
+    halted: bool,
+    init: SobolSampler,
+    grid: CellGrid,
+    sums: CellSums,
+    levels: Vec<f32>,
+    g: Vec<f32>,
+    s: Vec<f32>,
+    /// The level each cell's current feature was made with (its level may have moved since).
+    feature_level: Vec<f32>,
+    scale: Option<FeatureScale>,
+    clustering: Option<Clustering>,
+    /// Samples given to each pixel so far: the next sample's index there.
+    pixel_count: Vec<u32>,
+    /// Adaptive samples still to give.
+    remaining: u64,
+    heap: BinaryHeap<Ranked>,
+    version: Vec<u32>,
+    /// Samples planned for each cluster in the round being planned.
+    planned: Vec<u64>,
+    /// The clusters sampled in the round under way.
+    round_clusters: Vec<u32>,
+    /// The cell and in-cell offsets of each point of the round under way, in batch order.
+    round_cells: Vec<(u32, [f32; MAX_DIMS])>,
+    /// Cells that received samples since the last update.
+    touched: Vec<u32>,
+    stamp: Vec<u32>,
+    generation: u32,
+    rounds: u64,
+    partition: Option<Partition>,
+}
+
+impl ClusterSampler {
+    /// A sampler over `space` with `settings`, every random decision drawn from `seed`.
+    pub fn new(space: RenderingSpace, settings: ClusterSettings, seed: u64) -> Self {
+        let mut settings = settings;
+        settings.spp = settings.spp.max(1);
+        settings.init_spp = settings
+            .init_spp
+            .max(settings.min_spp)
+            .clamp(1, settings.spp);
+        let grid = CellGrid::new(space, settings.cell_size, settings.bins);
+        let sums = CellSums::new(&grid);
+        let cells = grid.len();
+        let pixels = space.pixels();
+        Self {
+            init: SobolSampler::new(space, settings.init_spp, seed ^ SALT),
+            remaining: pixels * u64::from(settings.spp - settings.init_spp),
+            settings,
+            seed,
+            space,
+            phase: Phase::Init,
+            halted: false,
+            grid,
+            sums,
+            levels: Vec::new(),
+            g: vec![0.0; cells],
+            s: vec![0.0; cells],
+            feature_level: Vec::new(),
+            scale: None,
+            clustering: None,
+            pixel_count: vec![0; pixels as usize],
+            heap: BinaryHeap::new(),
+            version: Vec::new(),
+            planned: Vec::new(),
+            round_clusters: Vec::new(),
+            round_cells: Vec::new(),
+            touched: Vec::new(),
+            stamp: vec![0; cells],
+            generation: 0,
+            rounds: 0,
+            partition: None,
+        }
+    }
+
+    /// The settings in force (after `minspp` raised `initspp` where needed).
+    pub fn settings(&self) -> &ClusterSettings {
+        &self.settings
+    }
+
+    /// The cell grid.
+    pub fn grid(&self) -> &CellGrid {
+        &self.grid
+    }
+
+    /// The cells' running sums.
+    pub fn sums(&self) -> &CellSums {
+        &self.sums
+    }
+
+    /// The clustering, once the first stage is done.
+    pub fn clustering(&self) -> Option<&Clustering> {
+        self.clustering.as_ref()
+    }
+
+    /// Bytes held by the sampler's per-cell and per-pixel state.
+    pub fn bytes(&self) -> usize {
+        self.sums.bytes()
+            + (self.levels.capacity()
+                + self.feature_level.capacity()
+                + self.g.capacity()
+                + self.s.capacity())
+                * 4
+            + self.stamp.capacity() * 4
+            + self.pixel_count.capacity() * 4
+            + self.clustering.as_ref().map_or(0, Clustering::bytes)
+            + self.heap.capacity() * std::mem::size_of::<Ranked>()
+    }
+
+    /// The index of pixel `p` in `pixel_count`.
+    #[inline]
+    fn pixel_index(&self, p: [u32; 2]) -> usize {
+        (p[1] - self.space.y0) as usize * self.space.width() as usize
+            + (p[0] - self.space.x0) as usize
+    }
+
+    /// The sampling priority of `c` with `extra` samples planned on top of its own.
+    fn priority(&self, c: &Cluster, extra: u64) -> f64 {
+        let tolerance = self.clustering.as_ref().map_or(0.0, |k| k.rule.tolerance);
+        match self.settings.priority {
+            Priority::Paper => c.err(),
+            Priority::PerSample => {
+                // A cluster of cells that agree has err 0 however noisy or curved they are:
+                // its mean gradient and variance features count too.
+                let mean = c.mean();
+                let err = c.err() + mean[0].abs() + mean[1].abs() + tolerance;
+                err * c.cells.len() as f64 / (c.samples + extra).max(1) as f64
+            }
+        }
+    }
+
+    fn push(&mut self, id: u32) {
+        let c = &self.clustering.as_ref().expect("clustered").clusters[id as usize];
+        if c.cells.is_empty() {
+            return;
+        }
+        let priority = self.priority(c, 0);
+        self.heap.push(Ranked {
+            priority,
+            id,
+            version: self.version[id as usize],
+        });
+    }
+
+    /// Ends the first stage: every cell's level and features, their scales, the clusters.
+    fn cluster(&mut self) {
+        let (grid, sums) = (&self.grid, &self.sums);
+        self.levels = (0..grid.len())
+            .into_par_iter()
+            .map(|i| level(grid, sums, i))
+            .collect();
+        let levels = &self.levels;
+        let raws: Vec<(f32, f32)> = (0..grid.len())
+            .into_par_iter()
+            .map(|i| raw(grid, sums, levels, i))
+            .collect();
+        for (i, (g, s)) in raws.into_iter().enumerate() {
+            self.g[i] = g;
+            self.s[i] = s;
+        }
+        let n = grid.dims();
+        // Positions in units of the side of a cube of maxclustercells cells, so that a full
+        // cluster spans about 1 in every dim whatever the resolution or bins.
+        let unit = f64::from(self.settings.max_cluster_cells).powf(1.0 / n as f64);
+        let scale = FeatureScale::measure(
+            sums,
+            &self.g,
+            &self.s,
+            &self.levels,
+            self.settings.weights,
+            unit,
+            self.settings.log_features,
+        );
+        let (g, s) = (&self.g, &self.s);
+        self.feature_level = self.levels.clone();
+        let levels = &self.levels;
+        let feature = |i: usize| scale.feature(n, &grid.coords(i), g[i], s[i], levels[i]);
+        // The tolerance of eq. 10 is the typical distance between neighbouring cells' features
+        // (the median, over sampled cells, of the distance to the next cell along x): a
+        // cluster of one cell then takes neighbours that differ by noise and refuses those
+        // that differ by an edge. Without noise it is one cell step.
+        let mut steps: Vec<f64> = (0..grid.len())
+            .into_par_iter()
+            .filter(|&i| sums.count[i] > 0)
+            .map(|i| {
+                let c = grid.coords(i);
+                let j = grid
+                    .step(i, &c, 0, true)
+                    .or_else(|| grid.step(i, &c, 0, false))
+                    .unwrap_or(i);
+                distance(&feature(i), &feature(j))
+            })
+            .collect();
+        let tolerance = if steps.is_empty() {
+            scale.cell_step()
+        } else {
+            let k = steps.len() / 2;
+            *steps.select_nth_unstable_by(k, f64::total_cmp).1
+        }
+        .max(scale.cell_step())
+            * (1.0 + 1e-9);
+        let rule = Membership {
+            omega: self.settings.omega,
+            tolerance,
+            max_cells: self.settings.max_cluster_cells as usize,
+        };
+        let clustering = Clustering::grow(grid, rule, feature, |i| u64::from(sums.count[i]));
+        self.scale = Some(scale);
+        self.version = vec![0; clustering.clusters.len()];
+        self.planned = vec![0; clustering.clusters.len()];
+        self.clustering = Some(clustering);
+        for id in 0..self.version.len() as u32 {
+            self.push(id);
+        }
+    }
+
+    /// Plans the next round into `out`: clusters by priority, a few samples each, until the
+    /// round holds its share of what is left.
+    fn plan_round(&mut self, out: &mut Vec<SamplePoint>) {
+        let target = (self.remaining / 16)
+            .clamp(MIN_ROUND, BATCH_SAMPLES)
+            .min(self.remaining);
+        let mut picks: Vec<(u32, u64)> = Vec::new();
+        let mut planned_total = 0;
+        let mut deferred = Vec::new();
+        while planned_total < target {
+            let Some(top) = self.heap.pop() else {
+                if deferred.is_empty() {
+                    break;
+                }
+                self.heap.extend(deferred.drain(..));
+                continue;
+            };
+            let clustering = self.clustering.as_ref().expect("clustered");
+            let c = &clustering.clusters[top.id as usize];
+            if c.cells.is_empty() || self.version[top.id as usize] != top.version {
+                continue;
+            }
+            let k = (c.cells.len() as u64)
+                .clamp(CLUSTER_SAMPLES.0, CLUSTER_SAMPLES.1)
+                .min(target - planned_total);
+            picks.push((top.id, k));
+            planned_total += k;
+            self.planned[top.id as usize] += k;
+            match self.settings.priority {
+                Priority::PerSample => {
+                    let priority = self.priority(c, self.planned[top.id as usize]);
+                    self.heap.push(Ranked { priority, ..top });
+                }
+                // The paper's rule takes each cluster once per round, by largest error.
+                Priority::Paper => deferred.push(top),
+            }
+        }
+        self.heap.extend(deferred);
+        let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
+        let clustering = self.clustering.as_ref().expect("clustered");
+        let n = self.grid.dims();
+        let mut points: Vec<(SamplePoint, u32, [f32; MAX_DIMS])> =
+            Vec::with_capacity(planned_total as usize);
+        let mut scratch = Vec::with_capacity(1);
+        for &(id, k) in &picks {
+            self.planned[id as usize] = 0;
+            let cells = &clustering.clusters[id as usize].cells;
+            let m = cells.len() as f64;
+            // Systematic sampling over the cluster's cells from a random start: k samples
+            // cover the cells evenly rather than by chance.
+            let start = f64::from(rng.next_f32()) * m;
+            for j in 0..k {
+                let slot = ((start + j as f64 * m / k as f64) as usize) % cells.len();
+                let mut u = [0.5f32; MAX_DIMS];
+                for v in &mut u[..n] {
+                    *v = rng.next_f32();
+                }
+                let cell = cells[slot];
+                if self.settings.even_pixels {
+                    // Only the pixel is chosen here; the point is the pixel's next one.
+                    let pixel = self.grid.pixel(cell as usize, &u);
+                    let p = self.pixel_index(pixel);
+                    let index = self.pixel_count[p];
+                    self.pixel_count[p] += 1;
+                    scratch.clear();
+                    self.init.pixel(pixel, index..index + 1, &mut scratch);
+                    let q = scratch[0];
+                    let (cell, off) = self.grid.locate(&q);
+                    points.push((q, cell as u32, off));
+                } else {
+                    let mut q = self.grid.point(cell as usize, &u);
+                    let p = self.pixel_index(q.pixel);
+                    q.index = self.pixel_count[p];
+                    self.pixel_count[p] += 1;
+                    points.push((q, cell, u));
+                }
+            }
+        }
+        // The film takes samples sorted by row: a stable counting sort, O(n).
+        let (y0, rows) = (self.space.y0, self.space.height() as usize);
+        let mut start = vec![0usize; rows + 1];
+        for (q, _, _) in &points {
+            start[(q.pixel[1] - y0) as usize + 1] += 1;
+        }
+        for r in 0..rows {
+            start[r + 1] += start[r];
+        }
+        out.clear();
+        self.round_cells.clear();
+        if let Some(first) = points.first() {
+            out.resize(points.len(), first.0);
+            self.round_cells.resize(points.len(), (first.1, first.2));
+        }
+        for (q, cell, u) in points {
+            let r = &mut start[(q.pixel[1] - y0) as usize];
+            out[*r] = q;
+            self.round_cells[*r] = (cell, u);
+            *r += 1;
+        }
+        self.round_clusters = picks.iter().map(|&(id, _)| id).collect();
+        self.remaining -= planned_total;
+        self.rounds += 1;
+    }
+
+    /// Table 1's UpdateCluster after a round: new levels and features for the cells that got
+    /// samples and their face neighbours, then the cells that no longer fit move.
+    fn update(&mut self) {
+        self.generation += 1;
+        let gen = self.generation;
+        // The cells that got samples get new features; their neighbours' levels follow where
+        // those are filled in from them (no samples of their own), but their features wait
+        // until they are sampled: recomputing them too (table 1) cost 5 to 11 times as much
+        // (one feature per face neighbour) for features that move by one cell's share.
+        let mut dirty: Vec<u32> = Vec::with_capacity(self.touched.len());
+        for &c in &self.touched {
+            if self.stamp[c as usize] != gen {
+                self.stamp[c as usize] = gen;
+                dirty.push(c);
+            }
+        }
+        self.touched.clear();
+        dirty.sort_unstable();
+        let (grid, sums) = (&self.grid, &self.sums);
+        let mut empty: Vec<u32> = dirty
+            .par_iter()
+            .flat_map_iter(|&c| {
+                let mut nbrs = Vec::with_capacity(2 * MAX_DIMS);
+                grid.neighbours(c as usize, &mut nbrs);
+                nbrs.retain(|&j| sums.count[j] == 0);
+                nbrs.into_iter().map(|j| j as u32)
+            })
+            .collect();
+        empty.par_sort_unstable();
+        empty.dedup();
+        let new_levels: Vec<f32> = dirty
+            .par_iter()
+            .chain(empty.par_iter())
+            .map(|&i| level(grid, sums, i as usize))
+            .collect();
+        for (&i, l) in dirty.iter().chain(&empty).zip(new_levels) {
+            self.levels[i as usize] = l;
+        }
+        let mut nbrs = Vec::new();
+        let (grid, sums) = (&self.grid, &self.sums);
+        let levels = &self.levels;
+        let raws: Vec<(f32, f32)> = dirty
+            .par_iter()
+            .map(|&i| raw(grid, sums, levels, i as usize))
+            .collect();
+        let scale = self.scale.expect("clustered");
+        let clustering = self.clustering.as_mut().expect("clustered");
+        let n = grid.dims();
+        let mut changed: Vec<u32> = std::mem::take(&mut self.round_clusters);
+        for (&i, (g, s)) in dirty.iter().zip(raws) {
+            let i = i as usize;
+            let level = self.levels[i];
+            if g == self.g[i] && s == self.s[i] && level == self.feature_level[i] {
+                continue;
+            }
+            let c = grid.coords(i);
+            let old = scale.feature(n, &c, self.g[i], self.s[i], self.feature_level[i]);
+            let new = scale.feature(n, &c, g, s, level);
+            self.g[i] = g;
+            self.s[i] = s;
+            self.feature_level[i] = level;
+            let (a, b) =
+                clustering.update(grid, i, &old, &new, u64::from(sums.count[i]), &mut nbrs);
+            changed.push(a);
+            changed.extend(b);
+        }
+        let live = clustering.live();
+        if self.version.len() < clustering.clusters.len() {
+            self.version.resize(clustering.clusters.len(), 0);
+            self.planned.resize(clustering.clusters.len(), 0);
+        }
+        changed.sort_unstable();
+        changed.dedup();
+        for &id in &changed {
+            self.version[id as usize] = self.version[id as usize].wrapping_add(1);
+        }
+        if self.heap.len() > 2 * live + 1024 {
+            // Mostly stale entries: rebuild.
+            self.heap.clear();
+            for id in 0..self.version.len() as u32 {
+                self.push(id);
+            }
+        } else {
+            for id in changed {
+                self.push(id);
+            }
+        }
+    }
+
+    /// The final partition in image space: each pixel takes the cluster of most of the cells
+    /// at its centre (ties to the lower id), ids renumbered in order of first appearance.
+    fn make_partition(&self) -> Option<Partition> {
+        let clustering = self.clustering.as_ref()?;
+        let (w, h) = (self.space.width(), self.space.height());
+        let inner = self.grid.cells_per_image_cell();
+        let mut renumber = vec![UNASSIGNED; clustering.clusters.len()];
+        let mut next = 0;
+        let mut cluster = Vec::with_capacity(w as usize * h as usize);
+        let mut votes: Vec<u32> = Vec::with_capacity(inner);
+        for py in 0..h {
+            for px in 0..w {
+                let (cx, cy) = self.grid.image_cell_of_pixel(px, py);
+                let mut c = [0; MAX_DIMS];
+                c[0] = cx;
+                c[1] = cy;
+                let first = self.grid.index(&c);
+                votes.clear();
+                votes.extend((first..first + inner).map(|i| clustering.of_cell[i]));
+                votes.sort_unstable();
+                let mut best = (0, votes[0]);
+                let mut run = 0;
+                for (k, &v) in votes.iter().enumerate() {
+                    run = if k > 0 && votes[k - 1] == v {
+                        run + 1
+                    } else {
+                        1
+                    };
+                    if run > best.0 {
+                        best = (run, v);
+                    }
+                }
+                let id = &mut renumber[best.1 as usize];
+                if *id == UNASSIGNED {
+                    *id = next;
+                    next += 1;
+                }
+                cluster.push(*id);
+            }
+        }
+        Some(Partition {
+            width: w,
+            height: h,
+            cluster,
+        })
+    }
+
+    fn finish(&mut self) {
+        self.phase = Phase::Done;
+        if self.partition.is_none() {
+            self.partition = self.make_partition();
+        }
+    }
+}
+
+impl Sampler for ClusterSampler {
+    fn name(&self) -> &'static str {
+        "cluster"
+    }
+
+    fn spp(&self) -> u32 {
+        self.settings.spp
+    }
+
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+        out.clear();
+        if self.phase == Phase::Init {
+            if self.init.next_batch(out) {
+                for q in out.iter() {
+                    let p = self.pixel_index(q.pixel);
+                    self.pixel_count[p] += 1;
+                }
+                return true;
+            }
+            if self.space.pixels() == 0 {
+                self.phase = Phase::Done;
+                return false;
+            }
+            self.cluster();
+            self.phase = if self.halted {
+                Phase::Done
+            } else {
+                Phase::Adaptive
+            };
+        }
+        if self.phase == Phase::Adaptive && !self.halted && self.remaining > 0 {
+            self.plan_round(out);
+            if !out.is_empty() {
+                return true;
+            }
+        }
+        self.finish();
+        false
+    }
+
+    fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        let adaptive = self.phase == Phase::Adaptive && self.round_cells.len() == batch.len();
+        for (k, (q, l)) in batch.iter().zip(radiance).enumerate() {
+            // An adaptive point's cell is known from when it was made.
+            let (cell, off) = if adaptive {
+                let (c, u) = self.round_cells[k];
+                (c as usize, u)
+            } else {
+                self.grid.locate(q)
+            };
+            if let Some(k) = self.clustering.as_mut() {
+                k.spend(cell, 1);
+            }
+            // NaN marks a dropped sample: it was spent but tells nothing.
+            if l[0].is_nan() {
+                continue;
+            }
+            self.sums.add(cell, &off, Spectrum::from_array(*l));
+            if adaptive {
+                self.touched.push(cell as u32);
+            }
+        }
+        if self.phase == Phase::Adaptive {
+            // A round is one batch: update now.
+            self.update();
+        }
+    }
+
+    fn halt(&mut self) {
+        self.halted = true;
+        self.init.halt();
+    }
+
+    fn partition(&self) -> Option<&Partition> {
+        self.partition.as_ref()
+    }
+
+    fn report(&self) -> SamplerReport {
+        SamplerReport {
+            clusters: self.clustering.as_ref().map(|c| c.live() as u64),
+            cells: Some(self.grid.len() as u64),
+            rounds: Some(self.rounds),
+        }
+    }
+}
+
+/// The registry's entry.
+pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
+    info: PluginInfo {
+        kind: Kind::Sampler,
+        name: "cluster",
+        doc: "adaptive cluster sampling: cells grouped by gradient, variance and position; \
+              samples go to the clusters of highest error per sample",
+        params: &[
+            ParamSpec::new(
+                "pixelsamples",
+                ParamType::Integer,
+                "16",
+                "samples per pixel on average (--spp overrides); the budget is spp x pixels",
+            ),
+            ParamSpec::new(
+                "omega",
+                ParamType::Float,
+                "0.7",
+                "eq. 10's ω: a cell joins a cluster while ω|F - mean F| <= err; larger: smaller clusters",
+            ),
+            ParamSpec::new(
+                "cellsize",
+                ParamType::Float,
+                "1",
+                "pixels per cell side in x and y (0.5: quarter-pixel cells)",
+            ),
+            ParamSpec::new(
+                "bins",
+                ParamType::Integer,
+                "1",
+                "cells along each time and lens dim (1: no cut)",
+            ),
+            ParamSpec::new(
+                "initspp",
+                ParamType::Integer,
+                "spp/4, at least 1",
+                "samples per pixel of the first, uniform stage",
+            ),
+            ParamSpec::new(
+                "minspp",
+                ParamType::Integer,
+                "1",
+                "fewest samples a pixel ends with",
+            ),
+            ParamSpec::new(
+                "maxclustercells",
+                ParamType::Integer,
+                "64",
+                "most cells in one cluster",
+            ),
+            ParamSpec::new(
+                "gradweight",
+                ParamType::Float,
+                "1",
+                "weight of the affine-invariant gradient in the feature distance",
+            ),
+            ParamSpec::new(
+                "varweight",
+                ParamType::Float,
+                "1",
+                "weight of the cell variance in the feature distance",
+            ),
+            ParamSpec::new(
+                "posweight",
+                ParamType::Float,
+                "0.015625",
+                "weight of the cell position in the feature distance",
+            ),
+            ParamSpec::new(
+                "levelweight",
+                ParamType::Float,
+                "1",
+                "weight of the cell's mean luminance in the feature distance (not in the paper)",
+            ),
+            ParamSpec::new(
+                "evenpixels",
+                ParamType::Bool,
+                "true",
+                "spread each pixel's points evenly over it and its time and lens bins, as \
+                 splatting filters need (false: sample the chosen cells themselves)",
+            ),
+            ParamSpec::new(
+                "logfeatures",
+                ParamType::Bool,
+                "true",
+                "log-compress the gradient and variance features, ln(1 + x)",
+            ),
+            ParamSpec::new(
+                "priority",
+                ParamType::String,
+                "persample",
+                "which clusters get samples: persample (err x cells / samples) or paper (err)",
+            ),
+        ],
+    },
+    build,
+};
+
+/// A float parameter that must lie in `range`, or an error at its location.
+fn float_in(
+    params: &ParamList,
+    name: &str,
+    default: f64,
+    range: std::ops::RangeInclusive<f64>,
+) -> Result<f64> {
+    let v = params.float_or(name, default)?;
+    if !range.contains(&v) {
+        let p = params.get(name).expect("a default lies in range");
+        return Err(Error::at(
+            &p.loc,
+            format!(
+                "{name} {v} is out of range ({} to {})",
+                range.start(),
+                range.end()
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+/// An integer parameter that must lie in `range`, or an error at its location.
+fn int_in(
+    params: &ParamList,
+    name: &str,
+    default: i32,
+    range: std::ops::RangeInclusive<i64>,
+) -> Result<u32> {
+    let v = i64::from(params.int_or(name, default)?);
+    if !range.contains(&v) {
+        let p = params.get(name).expect("a default lies in range");
+        return Err(Error::at(
+            &p.loc,
+            format!(
+                "{name} {v} is out of range ({} to {})",
+                range.start(),
+                range.end()
+            ),
+        ));
+    }
+    Ok(v as u32)
+}
+
+fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
+    let p = &c.params;
+    let spp = super::pixel_samples(p, setup)?;
+    let mut s = ClusterSettings::new(spp);
+    s.omega = float_in(p, "omega", s.omega, 1e-3..=1e3)?;
+    s.cell_size = float_in(p, "cellsize", s.cell_size, 0.125..=64.0)?;
+    s.bins = int_in(p, "bins", s.bins as i32, 1..=16)?;
+    let max = i64::from(spp);
+    s.init_spp = int_in(p, "initspp", s.init_spp as i32, 1..=max)?;
+    s.min_spp = int_in(p, "minspp", 1, 0..=max)?;
+    s.max_cluster_cells = int_in(p, "maxclustercells", 64, 1..=1 << 24)?;
+    for (k, name) in ["gradweight", "varweight", "posweight", "levelweight"]
+        .iter()
+        .enumerate()
+    {
+        s.weights[k] = float_in(p, name, s.weights[k], 0.0..=1e6)?;
+    }
+    s.even_pixels = p.bool_or("evenpixels", true)?;
+    s.log_features = p.bool_or("logfeatures", s.log_features)?;
+    s.priority = match p.string("priority")? {
+        None | Some("persample") => Priority::PerSample,
+        Some("paper") => Priority::Paper,
+        Some(other) => {
+            let loc = &p.get("priority").expect("given").loc;
+            return Err(Error::at(
+                loc,
+                format!("priority \"{other}\" is not known (persample or paper)"),
+            ));
+        }
+    };
+    // Cells beyond what memory can hold are refused before anything is allocated.
+    let grid_cells = {
+        let along = |w: u32| (f64::from(w) / s.cell_size).ceil().max(1.0);
+        along(setup.space.width())
+            * along(setup.space.height())
+            * f64::from(s.bins).powi(setup.space.dims.count() as i32 - 2)
+    };
+    if grid_cells > MAX_CELLS as f64 {
+        let loc = p
+            .get("cellsize")
+            .or_else(|| p.get("bins"))
+            .map(|x| x.loc.clone());
+        let message = format!(
+            "the cluster sampler's grid would have {grid_cells:.0} cells (most {MAX_CELLS}); \
+             raise cellsize or lower bins"
+        );
+        return Err(match loc {
+            Some(l) => Error::at(&l, message),
+            None => Error::file("cluster sampler", message),
+        });
+    }
+    Ok(Box::new(ClusterSampler::new(setup.space, s, setup.seed)))
+}
+
+/// Most cells the grid may have: about 80 bytes each, so 2^26 cells stay within 6 GiB.
+pub const MAX_CELLS: u64 = 1 << 26;
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{space, ALL_DIMS};
+    use super::*;
+
+    /// Runs `s` to the end on radiance `f`, halting after `halt_after` batches if given.
+    fn run(
+        s: &mut ClusterSampler,
+        f: impl Fn(&SamplePoint) -> [f32; 3],
+        halt_after: Option<usize>,
+    ) -> Vec<SamplePoint> {
+        let (mut all, mut b) = (Vec::new(), Vec::new());
+        let mut batches = 0;
+        while s.next_batch(&mut b) {
+            let r: Vec<[f32; 3]> = b.iter().map(&f).collect();
+            s.observe(&b, &r);
+            all.extend_from_slice(&b);
+            batches += 1;
+            if halt_after == Some(batches) {
+                s.halt();
+            }
+        }
+        all
+    }
+
+    fn field(q: &SamplePoint) -> [f32; 3] {
+        let v = if q.film[0] + 8.0 * q.time > 12.0 {
+            1.0
+        } else {
+            0.2
+        };
+        [v, v * 0.5, v * 0.25]
+    }
+
+    #[test]
+    fn every_dims_spends_the_budget_and_stays_in_range() {
+        for dims in ALL_DIMS {
+            let sp = space(3, 2, 20, 12, dims);
+            for bins in [1, 2] {
+                let set = ClusterSettings {
+                    bins,
+                    ..ClusterSettings::new(6)
+                };
+                let mut s = ClusterSampler::new(sp, set, 4);
+                let pts = run(&mut s, field, None);
+                assert_eq!(pts.len(), 20 * 12 * 6, "{dims:?}");
+                for q in &pts {
+                    assert!(
+                        q.pixel[0] >= 3 && q.pixel[0] < 23 && q.pixel[1] >= 2 && q.pixel[1] < 14
+                    );
+                    if dims.time {
+                        assert!((0.0..1.0).contains(&q.time));
+                    } else {
+                        assert_eq!(q.time, 0.5);
+                    }
+                    if dims.lens {
+                        assert!(q.lens.iter().all(|l| (0.0..1.0).contains(l)));
+                    } else {
+                        assert_eq!(q.lens, [0.5; 2]);
+                    }
+                }
+                let p = s.partition().expect("a partition at the end");
+                assert_eq!((p.width, p.height), (20, 12));
+                assert_eq!(p.cluster.len(), 240);
+                // Every cell in exactly one cluster.
+                let c = s.clustering().expect("clustered");
+                let total: usize = c.clusters.iter().map(|k| k.cells.len()).sum();
+                assert_eq!(total, s.grid().len());
+                assert!(c.of_cell.iter().all(|&k| k != UNASSIGNED));
+            }
+        }
+    }
+
+    #[test]
+    fn knobs_change_the_grid_and_the_first_stage() {
+        let sp = space(0, 0, 16, 8, ALL_DIMS[1]);
+        let mut set = ClusterSettings::new(8);
+        set.cell_size = 0.5;
+        set.bins = 3;
+        set.init_spp = 3;
+        set.min_spp = 5;
+        let mut s = ClusterSampler::new(sp, set, 1);
+        // minspp raises the first stage: every pixel gets 5 before any adapts.
+        assert_eq!(s.settings().init_spp, 5);
+        assert_eq!(s.grid().shape(), [32, 16, 3]);
+        let pts = run(&mut s, field, None);
+        let mut count = vec![0; 128];
+        for q in &pts {
+            count[(q.pixel[1] * 16 + q.pixel[0]) as usize] += 1;
+        }
+        assert!(count.iter().all(|&c| c >= 5));
+        assert_eq!(pts.len(), 128 * 8);
+    }
+
+    #[test]
+    fn halting_in_the_first_stage_finishes_its_pass_and_stops() {
+        let sp = space(0, 0, 300, 200, ALL_DIMS[0]);
+        let mut s = ClusterSampler::new(sp, ClusterSettings::new(16), 2);
+        let pts = run(&mut s, field, Some(1));
+        // The first stage's first pass (4 spp over 60,000 pixels spans several batches).
+        let mut count = vec![0u32; 60_000];
+        for q in &pts {
+            count[(q.pixel[1] * 300 + q.pixel[0]) as usize] += 1;
+        }
+        let first = count[0];
+        assert!(first >= 1 && count.iter().all(|&c| c == first));
+        assert!(s.partition().is_some(), "clusters still made for the AOV");
+        // Halted in the adaptive stage: stops at once.
+        let sp = space(0, 0, 40, 30, ALL_DIMS[1]);
+        let mut s = ClusterSampler::new(sp, ClusterSettings::new(16), 2);
+        let mut b = Vec::new();
+        while s.phase != Phase::Adaptive || s.rounds == 0 {
+            assert!(s.next_batch(&mut b));
+            let r: Vec<[f32; 3]> = b.iter().map(field).collect();
+            s.observe(&b, &r);
+        }
+        s.halt();
+        assert!(!s.next_batch(&mut b));
+        assert!(s.partition().is_some());
+    }
+
+    #[test]
+    fn dropped_samples_count_against_the_budget_and_poison_nothing() {
+        let sp = space(0, 0, 24, 16, ALL_DIMS[3]);
+        let mut s = ClusterSampler::new(sp, ClusterSettings::new(8), 3);
+        // Half the samples are NaN (dropped by the render loop).
+        let pts = run(
+            &mut s,
+            |q| {
+                if q.index % 2 == 0 {
+                    [f32::NAN; 3]
+                } else {
+                    field(q)
+                }
+            },
+            None,
+        );
+        assert_eq!(pts.len(), 24 * 16 * 8);
+        let sums = s.sums();
+        let kept: u64 = sums.count.iter().map(|&c| u64::from(c)).sum();
+        assert!(kept > 0 && kept < pts.len() as u64);
+        assert!(sums.lum.iter().all(|v| v.is_finite()));
+        assert!(s.g.iter().chain(&s.s).all(|v| v.is_finite()));
+    }
+
+    #[test]
+    fn memory_per_cell_keeps_1024_squared_5d_within_2_gib() {
+        // Measured on a small grid after a full run, then scaled to 1024 x 1024 x 8 cells.
+        let sp = space(0, 0, 64, 64, ALL_DIMS[3]);
+        let set = ClusterSettings {
+            bins: 2,
+            ..ClusterSettings::new(16)
+        };
+        let mut s = ClusterSampler::new(sp, set, 3);
+        run(&mut s, field, None);
+        let per_cell = s.bytes() as f64 / s.grid().len() as f64;
+        let at_1024 = per_cell * (1024.0 * 1024.0 * 8.0);
+        eprintln!(
+            "cluster sampler: {per_cell:.1} bytes per cell, {:.0} MiB at 1024^2 5D",
+            at_1024 / 1048576.0
+        );
+        assert!(
+            at_1024 < 1.5 * 1024.0 * 1024.0 * 1024.0,
+            "{per_cell} bytes per cell"
+        );
+    }
+
+    #[test]
+    fn bad_knobs_are_located_errors() {
+        use crate::registry::Setting;
+        let setup = SamplerSetup {
+            space: space(0, 0, 8, 8, ALL_DIMS[0]),
+            spp: None,
+            seed: 1,
+        };
+        for (arg, want) in [
+            ("sampler.omega=0", "omega 0 is out of range"),
+            ("sampler.bins=0", "bins 0 is out of range"),
+            ("sampler.initspp=99", "initspp 99 is out of range"),
+            ("sampler.cellsize=100", "cellsize 100 is out of range"),
+            ("sampler.priority=most", "priority \"most\" is not known"),
+        ] {
+            let mut c = Choice::new(None, "cluster", None);
+            Setting::parse(arg)
+                .expect(arg)
+                .apply(&ENTRY.info, &mut c)
+                .expect(arg);
+            let e = build(&c, &setup).err().expect(arg).to_string();
+            assert!(e.contains("--set:1:") && e.contains(want), "{e}");
+        }
+    }
+}
