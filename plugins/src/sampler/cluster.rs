@@ -7,9 +7,9 @@
 //! in a fixed order, and the parallel parts compute pure functions of the cells, so the points
 //! and the image do not depend on the thread count.
 
+use super::sobol::Scramble;
 use super::{
-    mix64, Pcg32, PixelPattern, Sampler, SamplerBuild, SamplerReport, SamplerSetup, SobolSampler,
-    BATCH_SAMPLES,
+    mix64, Pcg32, Sampler, SamplerBuild, SamplerReport, SamplerSetup, SobolSampler, BATCH_SAMPLES,
 };
 use crate::cluster::clusters::{distance, UNASSIGNED};
 use crate::cluster::features::{level, raw};
@@ -413,7 +413,6 @@ impl ClusterSampler {
         let n = self.grid.dims();
         let mut points: Vec<(SamplePoint, u32, [f32; MAX_DIMS])> =
             Vec::with_capacity(planned_total as usize);
-        let mut scratch = Vec::with_capacity(1);
         for &(id, k) in &picks {
             self.planned[id as usize] = 0;
             let cells = &clustering.clusters[id as usize].cells;
@@ -428,24 +427,23 @@ impl ClusterSampler {
                     *v = rng.next_f32();
                 }
                 let cell = cells[slot];
-                if self.settings.even_pixels {
-                    // Only the pixel is chosen here; the point is the pixel's next one.
-                    let pixel = self.grid.pixel(cell as usize, &u);
-                    let p = self.pixel_index(pixel);
-                    let index = self.pixel_count[p];
-                    self.pixel_count[p] += 1;
-                    scratch.clear();
-                    self.init.pixel(pixel, index..index + 1, &mut scratch);
-                    let q = scratch[0];
-                    let (cell, off) = self.grid.locate(&q);
-                    points.push((q, cell as u32, off));
+                let mut q = if self.settings.even_pixels {
+                    // Only the pixel is chosen here; the point is the pixel's next one, made
+                    // below in parallel.
+                    SamplePoint {
+                        pixel: self.grid.pixel(cell as usize, &u),
+                        index: 0,
+                        film: [0.0; 2],
+                        time: 0.5,
+                        lens: [0.5; 2],
+                    }
                 } else {
-                    let mut q = self.grid.point(cell as usize, &u);
-                    let p = self.pixel_index(q.pixel);
-                    q.index = self.pixel_count[p];
-                    self.pixel_count[p] += 1;
-                    points.push((q, cell, u));
-                }
+                    self.grid.point(cell as usize, &u)
+                };
+                let p = self.pixel_index(q.pixel);
+                q.index = self.pixel_count[p];
+                self.pixel_count[p] += 1;
+                points.push((q, cell, u));
             }
         }
         // The film takes samples sorted by row: a stable counting sort, O(n).
@@ -468,6 +466,18 @@ impl ClusterSampler {
             out[*r] = q;
             self.round_cells[*r] = (cell, u);
             *r += 1;
+        }
+        if self.settings.even_pixels {
+            let (init, grid) = (&self.init, &self.grid);
+            let seed = init.seed();
+            out.par_iter_mut()
+                .zip(self.round_cells.par_iter_mut())
+                .with_min_len(256)
+                .for_each(|(q, slot)| {
+                    *q = init.point(q.pixel, q.index, Scramble::of(q.pixel, seed));
+                    let (cell, off) = grid.locate(q);
+                    *slot = (cell as u32, off);
+                });
         }
         self.round_clusters = picks.iter().map(|&(id, _)| id).collect();
         self.remaining -= planned_total;

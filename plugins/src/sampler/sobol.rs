@@ -49,41 +49,69 @@ impl PixelPattern for SobolSampler {
     }
 
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
-        let dims = self.cursor.space().dims;
-        let key = pixel_key(p, self.seed, SALT);
-        let scramble = (key ^ (key >> 32)) as u32;
-        for index in indices {
-            let (off, time, lens) = if index < SOBOL_SAMPLES {
-                // One SIMD call gives dims 0-3; v (dim 4) only when the lens is on.
-                let s = sobol_burley::sample_4d(index, 0, scramble);
-                let lens = if dims.lens {
-                    [s[3], sobol_burley::sample(index, 4, scramble)]
-                } else {
-                    [0.5; 2]
-                };
-                ([s[0], s[1]], if dims.time { s[2] } else { 0.5 }, lens)
-            } else {
-                let mut rng = Pcg32::new(
-                    super::mix64(key ^ super::mix64(u64::from(index))),
-                    u64::from(index),
-                );
-                let off = [rng.next_f32(), rng.next_f32()];
-                let time = if dims.time { rng.next_f32() } else { 0.5 };
-                let lens = if dims.lens {
-                    [rng.next_f32(), rng.next_f32()]
-                } else {
-                    [0.5; 2]
-                };
-                (off, time, lens)
-            };
-            out.push(SamplePoint {
-                pixel: p,
-                index,
-                film: [in_pixel(p[0], off[0]), in_pixel(p[1], off[1])],
-                time,
-                lens,
-            });
+        let scramble = Scramble::of(p, self.seed);
+        out.extend(indices.map(|index| self.point(p, index, scramble)));
+    }
+}
+
+/// The per-pixel key and Sobol scramble of one pixel, computed once for its points.
+#[derive(Clone, Copy, Debug)]
+pub struct Scramble {
+    key: u64,
+    bits: u32,
+}
+
+impl Scramble {
+    /// The scramble of pixel `p` under `seed`.
+    pub fn of(p: [u32; 2], seed: u64) -> Self {
+        let key = pixel_key(p, seed, SALT);
+        Self {
+            key,
+            bits: (key ^ (key >> 32)) as u32,
         }
+    }
+}
+
+impl SobolSampler {
+    /// The `index`th point of pixel `p` (`scramble` from `Scramble::of(p, seed)`): any number
+    /// of a pixel's points, made in any order, form the same sequence.
+    pub fn point(&self, p: [u32; 2], index: u32, scramble: Scramble) -> SamplePoint {
+        let dims = self.cursor.space().dims;
+        let (off, time, lens) = if index < SOBOL_SAMPLES {
+            // One SIMD call gives dims 0-3; v (dim 4) only when the lens is on.
+            let s = sobol_burley::sample_4d(index, 0, scramble.bits);
+            let lens = if dims.lens {
+                [s[3], sobol_burley::sample(index, 4, scramble.bits)]
+            } else {
+                [0.5; 2]
+            };
+            ([s[0], s[1]], if dims.time { s[2] } else { 0.5 }, lens)
+        } else {
+            let mut rng = Pcg32::new(
+                super::mix64(scramble.key ^ super::mix64(u64::from(index))),
+                u64::from(index),
+            );
+            let off = [rng.next_f32(), rng.next_f32()];
+            let time = if dims.time { rng.next_f32() } else { 0.5 };
+            let lens = if dims.lens {
+                [rng.next_f32(), rng.next_f32()]
+            } else {
+                [0.5; 2]
+            };
+            (off, time, lens)
+        };
+        SamplePoint {
+            pixel: p,
+            index,
+            film: [in_pixel(p[0], off[0]), in_pixel(p[1], off[1])],
+            time,
+            lens,
+        }
+    }
+
+    /// The seed the points are scrambled from.
+    pub fn seed(&self) -> u64 {
+        self.seed
     }
 }
 
