@@ -5,6 +5,7 @@
 pub mod clusters;
 pub mod features;
 pub mod grid;
+pub mod queue;
 
 pub use clusters::{Cluster, Clustering, Membership, Moments};
 pub use features::{Feature, FeatureScale};

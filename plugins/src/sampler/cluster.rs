@@ -14,6 +14,7 @@ use super::{
 use crate::cluster::clusters::{distance, UNASSIGNED};
 use crate::cluster::features::{level, raw};
 use crate::cluster::grid::MAX_DIMS;
+use crate::cluster::queue::{BucketQueue, Queued};
 use crate::cluster::{CellGrid, CellSums, Cluster, Clustering, FeatureScale, Membership};
 use crate::film::Spectrum;
 use crate::partition::Partition;
@@ -21,8 +22,6 @@ use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{RenderingSpace, SamplePoint};
 use acr_parser::{Error, ParamList, ParamType, Result};
 use rayon::prelude::*;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// Salt of this sampler's random streams.
 const SALT: u64 = 0x636c_7573;
@@ -110,37 +109,6 @@ impl ClusterSettings {
     }
 }
 
-/// A cluster in the priority queue; ties go to the lower id, so the order is total.
-#[derive(Clone, Copy, Debug)]
-struct Ranked {
-    priority: f64,
-    id: u32,
-    version: u32,
-}
-
-impl PartialEq for Ranked {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-
-impl Eq for Ranked {}
-
-impl PartialOrd for Ranked {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-
-impl Ord for Ranked {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.priority
-            .total_cmp(&o.priority)
-            .then(o.id.cmp(&self.id))
-            .then(self.version.cmp(&o.version))
-    }
-}
-
 /// Where the sampler is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
@@ -170,7 +138,7 @@ pub struct ClusterSampler {
     pixel_count: Vec<u32>,
     /// Adaptive samples still to give.
     remaining: u64,
-    heap: BinaryHeap<Ranked>,
+    queue: BucketQueue,
     version: Vec<u32>,
     /// Samples planned for each cluster in the round being planned.
     planned: Vec<u64>,
@@ -216,7 +184,7 @@ impl ClusterSampler {
             scale: None,
             clustering: None,
             pixel_count: vec![0; pixels as usize],
-            heap: BinaryHeap::new(),
+            queue: BucketQueue::new(),
             version: Vec::new(),
             planned: Vec::new(),
             round_clusters: Vec::new(),
@@ -260,7 +228,7 @@ impl ClusterSampler {
             + self.stamp.capacity() * 4
             + self.pixel_count.capacity() * 4
             + self.clustering.as_ref().map_or(0, Clustering::bytes)
-            + self.heap.capacity() * std::mem::size_of::<Ranked>()
+            + self.queue.bytes()
     }
 
     /// The index of pixel `p` in `pixel_count`.
@@ -291,11 +259,8 @@ impl ClusterSampler {
             return;
         }
         let priority = self.priority(c, 0);
-        self.heap.push(Ranked {
-            priority,
-            id,
-            version: self.version[id as usize],
-        });
+        let version = self.version[id as usize];
+        self.queue.push(priority, Queued { id, version });
     }
 
     /// Ends the first stage: every cell's level and features, their scales, the clusters.
@@ -380,11 +345,13 @@ impl ClusterSampler {
         let mut planned_total = 0;
         let mut deferred = Vec::new();
         while planned_total < target {
-            let Some(top) = self.heap.pop() else {
+            let Some(top) = self.queue.pop() else {
                 if deferred.is_empty() {
                     break;
                 }
-                self.heap.extend(deferred.drain(..));
+                for (priority, e) in deferred.drain(..) {
+                    self.queue.push(priority, e);
+                }
                 continue;
             };
             let clustering = self.clustering.as_ref().expect("clustered");
@@ -401,13 +368,15 @@ impl ClusterSampler {
             match self.settings.priority {
                 Priority::PerSample => {
                     let priority = self.priority(c, self.planned[top.id as usize]);
-                    self.heap.push(Ranked { priority, ..top });
+                    self.queue.push(priority, top);
                 }
                 // The paper's rule takes each cluster once per round, by largest error.
-                Priority::Paper => deferred.push(top),
+                Priority::Paper => deferred.push((self.priority(c, 0), top)),
             }
         }
-        self.heap.extend(deferred);
+        for (priority, e) in deferred {
+            self.queue.push(priority, e);
+        }
         let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
         let clustering = self.clustering.as_ref().expect("clustered");
         let n = self.grid.dims();
@@ -560,9 +529,9 @@ impl ClusterSampler {
         for &id in &changed {
             self.version[id as usize] = self.version[id as usize].wrapping_add(1);
         }
-        if self.heap.len() > 2 * live + 1024 {
+        if self.queue.len() > 2 * live + 1024 {
             // Mostly stale entries: rebuild.
-            self.heap.clear();
+            self.queue.clear();
             for id in 0..self.version.len() as u32 {
                 self.push(id);
             }
