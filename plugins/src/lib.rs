@@ -7,6 +7,7 @@ pub mod film;
 pub mod filters;
 pub mod partition;
 pub mod registry;
+pub mod regression;
 pub mod rng;
 pub mod sampler;
 pub mod space;
