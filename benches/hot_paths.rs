@@ -372,7 +372,13 @@ fn film(c: &mut Criterion) {
         });
         group.throughput(Throughput::Elements(u64::from(RES * RES)));
         group.bench_function(BenchmarkId::new("reconstruct", name), |b| {
-            b.iter(|| pool.install(|| black_box(filter.reconstruct(&film, None))))
+            b.iter(|| {
+                pool.install(|| {
+                    black_box(
+                        filter.reconstruct(&film, acr_plugins::filters::SamplerOutput::default()),
+                    )
+                })
+            })
         });
     }
     group.finish();

@@ -1,7 +1,6 @@
 //! The `acr` command line: subcommands and their arguments.
 
 use crate::aov::{parse_aovs, write_aov, AovRequest};
-use crate::film::Film;
 use crate::image_io::{write_image, RgbImage};
 use crate::registry::{choose, Overrides};
 use crate::render::{render, rendering_space, MAX_SPP};
@@ -212,7 +211,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     }
     let t_built = Instant::now();
 
-    let mut film = Film::new(scene.film.clone(), plugins.filter.kernel());
+    let mut film = plugins.film(&scene);
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let bar = show_progress.then(|| {
         let b = indicatif::ProgressBar::new(0);
@@ -280,6 +279,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         clusters: report.clusters,
         cells: report.cells,
         rounds: report.rounds,
+        fitted_by_degree: plugins.filter.report().fitted_by_degree,
         dropped_samples: counts.dropped,
         seconds: Seconds {
             parse: (t_parsed - t_start).as_secs_f64(),

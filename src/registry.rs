@@ -5,7 +5,8 @@
 use crate::geometry::Spectrum;
 use crate::integrator::{Integrator, IntegratorBuild, INTEGRATORS};
 use acr_parser::{Result, SceneDescription, Warning};
-use acr_plugins::filters::FilterBuild;
+use acr_plugins::cluster::CellGrid;
+use acr_plugins::filters::{FilterBuild, SamplerOutput};
 use acr_plugins::registry::{check_params, lookup};
 use acr_plugins::sampler::SamplerBuild;
 use acr_plugins::Film;
@@ -44,12 +45,31 @@ pub struct Plugins {
 }
 
 impl Plugins {
+    /// An empty film for `scene`, splatting with the filter's kernel, and collecting the cells
+    /// the filter needs when the sampler keeps none.
+    pub fn film(&self, scene: &crate::scene::Scene) -> Film {
+        let mut film = Film::new(scene.film.clone(), self.filter.kernel());
+        if let Some((cell_size, bins)) = self.filter.cell_layout() {
+            if !self.sampler.keeps_cells() {
+                let space = crate::render::rendering_space(scene);
+                film.collect_cells(CellGrid::new(space, cell_size, bins));
+            }
+        }
+        film
+    }
+
     /// The image from `film`: the filter's reconstruction, with the sampler's partition when it
     /// has one, times the film's `scale`; row-major over the cropped film.
     pub fn image(&self, film: &Film) -> Vec<Spectrum> {
         let scale = film.settings().scale;
         self.filter
-            .reconstruct(film, self.sampler.partition())
+            .reconstruct(
+                film,
+                SamplerOutput {
+                    partition: self.sampler.partition(),
+                    cells: self.sampler.cells(),
+                },
+            )
             .into_iter()
             .map(|c| c * scale)
             .collect()

@@ -112,6 +112,7 @@ pub fn render(
         let t = Instant::now();
         sampler.observe(&batch, &radiance);
         in_sampler += t.elapsed();
+        film.add_points(&batch, &radiance);
         film.add_samples(&valid);
         counts.samples += batch.len() as u64;
         if let Some(p) = progress {

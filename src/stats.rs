@@ -56,6 +56,9 @@ pub struct Stats {
     pub cells: Option<u64>,
     /// Adaptive rounds of the cluster sampler (null for other samplers).
     pub rounds: Option<u64>,
+    /// Clusters the polynomial reconstruction fitted at degree 0, 1 and 2 (null for other
+    /// filters).
+    pub fitted_by_degree: Option<[u64; 3]>,
     /// Samples dropped for NaN, infinite or negative radiance.
     pub dropped_samples: u64,
     /// Time per phase.

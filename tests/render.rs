@@ -1,7 +1,6 @@
 //! Rendering tests: every example scene renders; analytic cases converge to their known values;
 //! acr agrees with pbrt-v3's own renders of the public scenes in ../shared.
 
-use acr::film::Film;
 use acr::geometry::Spectrum;
 use acr::parser::{parse_file, parse_str, Param, ParamType, SceneDescription, Values};
 use acr::registry::{choose, Overrides};
@@ -52,7 +51,7 @@ fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> Rendered {
     };
     let mut plugins =
         choose(desc, &Overrides::default(), setup, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut film = Film::new(scene.film.clone(), plugins.filter.kernel());
+    let mut film = plugins.film(&scene);
     let counts = render(
         &scene,
         &plugins.integrator,

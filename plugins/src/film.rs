@@ -3,7 +3,9 @@
 //! pixel's own samples' count, sum and sum of squares, for the spp and variance AOVs and for
 //! filters that reconstruct from per-pixel statistics.
 
+use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::filters::FilterKernel;
+use crate::space::SamplePoint;
 use acr_parser::{Error, PluginDesc, Result};
 use glam::{Vec2, Vec3};
 
@@ -166,6 +168,9 @@ pub struct Film {
     stats: Vec<PixelStats>,
     /// [`Film::add_samples`]'s prepared samples, kept to reuse the allocation.
     prepared: Vec<Prepared>,
+    /// Per-cell sums over the rendering space, for a reconstruction that fits cells when the
+    /// sampler keeps none ([`Film::collect_cells`]).
+    cells: Option<(CellGrid, CellSums)>,
 }
 
 /// Film columns a [`Prepared`] sample can reach: enough for filters of radius up to 3.5
@@ -350,7 +355,37 @@ impl Film {
             },
             settings,
             prepared: Vec::new(),
+            cells: None,
         }
+    }
+
+    /// Makes the film also keep running sums per cell of `grid` ([`Film::add_points`]).
+    pub fn collect_cells(&mut self, grid: CellGrid) {
+        let sums = CellSums::new(&grid);
+        self.cells = Some((grid, sums));
+    }
+
+    /// Adds each point of `batch` with its radiance to its cell, when the film collects cells;
+    /// NaN radiance marks a dropped sample and is skipped.
+    pub fn add_points(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        let Some((grid, sums)) = self.cells.as_mut() else {
+            return;
+        };
+        for (q, l) in batch.iter().zip(radiance) {
+            if l.iter().all(|v| v.is_finite()) {
+                let (cell, off) = grid.locate(q);
+                sums.add(cell, &off, Spectrum::from_array(*l));
+            }
+        }
+    }
+
+    /// The film's cells, when it collects them.
+    pub fn cells(&self) -> Option<CellView<'_>> {
+        self.cells.as_ref().map(|(grid, sums)| CellView {
+            grid,
+            sums,
+            clustering: None,
+        })
     }
 
     /// The settings it was made with.

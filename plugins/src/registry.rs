@@ -340,6 +340,50 @@ impl Setting {
     }
 }
 
+/// A float parameter that must lie in `range`, or an error at its location.
+pub(crate) fn float_in(
+    params: &ParamList,
+    name: &str,
+    default: f64,
+    range: std::ops::RangeInclusive<f64>,
+) -> Result<f64> {
+    let v = params.float_or(name, default)?;
+    if !range.contains(&v) {
+        let p = params.get(name).expect("a default lies in range");
+        return Err(Error::at(
+            &p.loc,
+            format!(
+                "{name} {v} is out of range ({} to {})",
+                range.start(),
+                range.end()
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+/// An integer parameter that must lie in `range`, or an error at its location.
+pub(crate) fn int_in(
+    params: &ParamList,
+    name: &str,
+    default: i32,
+    range: std::ops::RangeInclusive<i64>,
+) -> Result<u32> {
+    let v = i64::from(params.int_or(name, default)?);
+    if !range.contains(&v) {
+        let p = params.get(name).expect("a default lies in range");
+        return Err(Error::at(
+            &p.loc,
+            format!(
+                "{name} {v} is out of range ({} to {})",
+                range.start(),
+                range.end()
+            ),
+        ));
+    }
+    Ok(v as u32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -72,6 +72,7 @@ pub struct Fit {
     lo: [f64; 3],
     hi: [f64; 3],
     clamp: bool,
+    empty: bool,
 }
 
 /// Legendre polynomials P_0..P_(MAX_DEGREE + 1) at `x`.
@@ -119,6 +120,7 @@ impl Fit {
             lo: [f64::INFINITY; 3],
             hi: [0.0; 3],
             clamp: settings.clamp,
+            empty: false,
         };
         let usable = |c: &FitCell| {
             c.weight > 0.0 && c.weight.is_finite() && c.mean.iter().all(|v| v.is_finite())
@@ -146,6 +148,7 @@ impl Fit {
         }
         if total <= 0.0 {
             fit.lo = [0.0; 3];
+            fit.empty = true;
             return fit;
         }
         fit.coeffs[0] = mean.map(|m| m / total);
@@ -283,6 +286,11 @@ impl Fit {
             }
         }
         x.iter().flatten().all(|v| v.is_finite()).then_some(x)
+    }
+
+    /// Whether the cluster had no usable sample (its values are then 0 and mean nothing).
+    pub fn is_empty(&self) -> bool {
+        self.empty
     }
 
     /// The degree used, the largest over the dims (0: the weighted mean).

@@ -166,6 +166,17 @@ impl CellGrid {
         }
     }
 
+    /// The box of cell `i`: pixels from the space's corner in x and y, [0, 1] in the others.
+    pub fn bounds(&self, i: usize) -> ([f64; MAX_DIMS], [f64; MAX_DIMS]) {
+        let c = self.coords(i);
+        let mut lo = [0.0; MAX_DIMS];
+        let mut hi = [0.0; MAX_DIMS];
+        for d in 0..self.n {
+            (lo[d], hi[d]) = self.extent(d, c[d]);
+        }
+        (lo, hi)
+    }
+
     /// The cell coordinate along `dim` of position `v` (in the units of [`Self::position`]).
     #[inline]
     fn coord(&self, dim: usize, v: f64) -> u32 {
@@ -289,6 +300,9 @@ pub struct CellSums {
     pub lum_sq: Vec<f64>,
     /// Sum of the samples' offsets inside the cell, `dims` per cell, for their centroid.
     pub offset: Vec<f32>,
+    /// Sum of the squared offsets, `dims` per cell: with `offset`, the mean of any quadratic
+    /// over the cell's samples (the polynomial fit's rows).
+    pub offset_sq: Vec<f32>,
     dims: usize,
 }
 
@@ -303,6 +317,7 @@ impl CellSums {
             lum: vec![0.0; n],
             lum_sq: vec![0.0; n],
             offset: vec![0.0; n * grid.dims()],
+            offset_sq: vec![0.0; n * grid.dims()],
             dims: grid.dims(),
         }
     }
@@ -318,11 +333,14 @@ impl CellSums {
             self.rgb[i][c] += v;
             self.rgb_sq[i][c] += v * v;
         }
-        for (s, o) in self.offset[i * self.dims..][..self.dims]
+        let at = i * self.dims..(i + 1) * self.dims;
+        for ((s, s2), o) in self.offset[at.clone()]
             .iter_mut()
+            .zip(&mut self.offset_sq[at])
             .zip(off)
         {
             *s += o;
+            *s2 += o * o;
         }
     }
 
@@ -351,6 +369,12 @@ impl CellSums {
             + self.lum.capacity() * 8
             + self.lum_sq.capacity() * 8
             + self.offset.capacity() * 4
+            + self.offset_sq.capacity() * 4
+    }
+
+    /// Active dims (offsets per cell).
+    pub fn dims(&self) -> usize {
+        self.dims
     }
 }
 

@@ -2,6 +2,7 @@
 //! running sums, the feature vector of each cell, and clusters of cells. The cluster sampler
 //! drives it; a reconstruction that needs clusters builds them with the same code.
 
+pub mod build;
 pub mod clusters;
 pub mod features;
 pub mod grid;
@@ -10,3 +11,15 @@ pub mod queue;
 pub use clusters::{Cluster, Clustering, Membership, Moments};
 pub use features::{Feature, FeatureScale};
 pub use grid::{CellGrid, CellSums};
+
+/// A grid's cells, their sums and, when a sampler made them, their clusters: what the
+/// polynomial reconstruction reads.
+#[derive(Clone, Copy, Debug)]
+pub struct CellView<'a> {
+    /// The grid.
+    pub grid: &'a CellGrid,
+    /// Each cell's running sums.
+    pub sums: &'a CellSums,
+    /// The clusters of the cells, if made (else the reconstruction makes them).
+    pub clustering: Option<&'a Clustering>,
+}

@@ -4,15 +4,18 @@
 mod boxf;
 mod gaussian;
 mod mitchell;
+mod polynomial;
 mod sinc;
 mod triangle;
 
 pub use boxf::BoxFilter;
 pub use gaussian::GaussianFilter;
 pub use mitchell::MitchellFilter;
+pub use polynomial::PolynomialFilter;
 pub use sinc::LanczosSincFilter;
 pub use triangle::TriangleFilter;
 
+use crate::cluster::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
 use crate::registry::{Choice, Entry};
@@ -35,9 +38,37 @@ pub trait Filter: Send + Sync {
     /// filter that reconstructs from per-pixel statistics instead).
     fn kernel(&self) -> &dyn FilterKernel;
 
-    /// The image, row-major over the film's (cropped) pixels; `partition` is the sampler's,
-    /// when it has one.
-    fn reconstruct(&self, film: &Film, partition: Option<&Partition>) -> Vec<Spectrum>;
+    /// The image, row-major over the film's (cropped) pixels, from the film and what the
+    /// sampler hands over.
+    fn reconstruct(&self, film: &Film, from: SamplerOutput<'_>) -> Vec<Spectrum>;
+
+    /// The cells (`cellsize` pixels, `bins` per non-image dim) the film must collect for this
+    /// filter when the sampler keeps none; None for a filter that needs no cells.
+    fn cell_layout(&self) -> Option<(f64, u32)> {
+        None
+    }
+
+    /// What the last reconstruction reports for the stats file (nothing, for a splatting
+    /// filter).
+    fn report(&self) -> FilterReport {
+        FilterReport::default()
+    }
+}
+
+/// A reconstruction's figures for the stats file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FilterReport {
+    /// Clusters fitted at degree 0, 1 and 2 (the polynomial reconstruction).
+    pub fitted_by_degree: Option<[u64; 3]>,
+}
+
+/// What a sampler hands the reconstruction besides the film.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SamplerOutput<'a> {
+    /// Its partition of the image into clusters, when it has one (an adaptive sampler).
+    pub partition: Option<&'a Partition>,
+    /// Its cells and clusters, when it keeps them.
+    pub cells: Option<CellView<'a>>,
 }
 
 /// pbrt-v3's filters: the film splats each sample with the kernel, and a pixel is the
@@ -64,8 +95,8 @@ impl<K: FilterKernel> Filter for Splatting<K> {
         &self.kernel
     }
 
-    fn reconstruct(&self, film: &Film, partition: Option<&Partition>) -> Vec<Spectrum> {
-        match partition {
+    fn reconstruct(&self, film: &Film, from: SamplerOutput<'_>) -> Vec<Spectrum> {
+        match from.partition {
             // An adaptive sampler spread its samples unevenly over the image.
             Some(_) => filter_pixel_means(film, &self.kernel),
             None => film.pixels(),
@@ -139,6 +170,7 @@ pub static FILTERS: &[Entry<FilterBuild>] = &[
     gaussian::ENTRY,
     mitchell::ENTRY,
     sinc::ENTRY,
+    polynomial::ENTRY,
 ];
 
 /// Doc of the `xwidth` parameter every pbrt-v3 filter has.

@@ -11,16 +11,17 @@ use super::sobol::Scramble;
 use super::{
     mix64, Pcg32, Sampler, SamplerBuild, SamplerReport, SamplerSetup, SobolSampler, BATCH_SAMPLES,
 };
-use crate::cluster::clusters::{distance, UNASSIGNED};
+use crate::cluster::build::{initial_clustering, ClusterParams};
+use crate::cluster::clusters::UNASSIGNED;
 use crate::cluster::features::{level, raw};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::queue::{BucketQueue, Queued};
-use crate::cluster::{CellGrid, CellSums, Cluster, Clustering, FeatureScale, Membership};
+use crate::cluster::{CellGrid, CellSums, CellView, Cluster, Clustering, FeatureScale};
 use crate::film::Spectrum;
 use crate::partition::Partition;
-use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{RenderingSpace, SamplePoint};
-use acr_parser::{Error, ParamList, ParamType, Result};
+use acr_parser::{Error, ParamType, Result};
 use rayon::prelude::*;
 
 /// Salt of this sampler's random streams.
@@ -265,68 +266,19 @@ impl ClusterSampler {
 
     /// Ends the first stage: every cell's level and features, their scales, the clusters.
     fn cluster(&mut self) {
-        let (grid, sums) = (&self.grid, &self.sums);
-        self.levels = (0..grid.len())
-            .into_par_iter()
-            .map(|i| level(grid, sums, i))
-            .collect();
-        let levels = &self.levels;
-        let raws: Vec<(f32, f32)> = (0..grid.len())
-            .into_par_iter()
-            .map(|i| raw(grid, sums, levels, i))
-            .collect();
-        for (i, (g, s)) in raws.into_iter().enumerate() {
-            self.g[i] = g;
-            self.s[i] = s;
-        }
-        let n = grid.dims();
-        // Positions in units of the side of a cube of maxclustercells cells, so that a full
-        // cluster spans about 1 in every dim whatever the resolution or bins.
-        let unit = f64::from(self.settings.max_cluster_cells).powf(1.0 / n as f64);
-        let scale = FeatureScale::measure(
-            sums,
-            &self.g,
-            &self.s,
-            &self.levels,
-            self.settings.weights,
-            unit,
-            self.settings.log_features,
-        );
-        let (g, s) = (&self.g, &self.s);
-        self.feature_level = self.levels.clone();
-        let levels = &self.levels;
-        let feature = |i: usize| scale.feature(n, &grid.coords(i), g[i], s[i], levels[i]);
-        // The tolerance of eq. 10 is the typical distance between neighbouring cells' features
-        // (the median, over sampled cells, of the distance to the next cell along x): a
-        // cluster of one cell then takes neighbours that differ by noise and refuses those
-        // that differ by an edge. Without noise it is one cell step.
-        let mut steps: Vec<f64> = (0..grid.len())
-            .into_par_iter()
-            .filter(|&i| sums.count[i] > 0)
-            .map(|i| {
-                let c = grid.coords(i);
-                let j = grid
-                    .step(i, &c, 0, true)
-                    .or_else(|| grid.step(i, &c, 0, false))
-                    .unwrap_or(i);
-                distance(&feature(i), &feature(j))
-            })
-            .collect();
-        let tolerance = if steps.is_empty() {
-            scale.cell_step()
-        } else {
-            let k = steps.len() / 2;
-            *steps.select_nth_unstable_by(k, f64::total_cmp).1
-        }
-        .max(scale.cell_step())
-            * (1.0 + 1e-9);
-        let rule = Membership {
+        let params = ClusterParams {
             omega: self.settings.omega,
-            tolerance,
-            max_cells: self.settings.max_cluster_cells as usize,
+            weights: self.settings.weights,
+            max_cluster_cells: self.settings.max_cluster_cells,
+            log_features: self.settings.log_features,
         };
-        let clustering = Clustering::grow(grid, rule, feature, |i| u64::from(sums.count[i]));
-        self.scale = Some(scale);
+        let initial = initial_clustering(&self.grid, &self.sums, &params);
+        self.feature_level = initial.levels.clone();
+        self.levels = initial.levels;
+        self.g = initial.g;
+        self.s = initial.s;
+        self.scale = Some(initial.scale);
+        let clustering = initial.clustering;
         self.version = vec![0; clustering.clusters.len()];
         self.planned = vec![0; clustering.clusters.len()];
         self.clustering = Some(clustering);
@@ -674,6 +626,18 @@ impl Sampler for ClusterSampler {
         self.partition.as_ref()
     }
 
+    fn cells(&self) -> Option<CellView<'_>> {
+        Some(CellView {
+            grid: &self.grid,
+            sums: &self.sums,
+            clustering: self.clustering.as_ref(),
+        })
+    }
+
+    fn keeps_cells(&self) -> bool {
+        true
+    }
+
     fn report(&self) -> SamplerReport {
         SamplerReport {
             clusters: self.clustering.as_ref().map(|c| c.live() as u64),
@@ -780,50 +744,6 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
     },
     build,
 };
-
-/// A float parameter that must lie in `range`, or an error at its location.
-fn float_in(
-    params: &ParamList,
-    name: &str,
-    default: f64,
-    range: std::ops::RangeInclusive<f64>,
-) -> Result<f64> {
-    let v = params.float_or(name, default)?;
-    if !range.contains(&v) {
-        let p = params.get(name).expect("a default lies in range");
-        return Err(Error::at(
-            &p.loc,
-            format!(
-                "{name} {v} is out of range ({} to {})",
-                range.start(),
-                range.end()
-            ),
-        ));
-    }
-    Ok(v)
-}
-
-/// An integer parameter that must lie in `range`, or an error at its location.
-fn int_in(
-    params: &ParamList,
-    name: &str,
-    default: i32,
-    range: std::ops::RangeInclusive<i64>,
-) -> Result<u32> {
-    let v = i64::from(params.int_or(name, default)?);
-    if !range.contains(&v) {
-        let p = params.get(name).expect("a default lies in range");
-        return Err(Error::at(
-            &p.loc,
-            format!(
-                "{name} {v} is out of range ({} to {})",
-                range.start(),
-                range.end()
-            ),
-        ));
-    }
-    Ok(v as u32)
-}
 
 fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
     let p = &c.params;

@@ -14,6 +14,7 @@ pub use random::RandomSampler;
 pub use sobol::{SobolSampler, SOBOL_DIMS_USED, SOBOL_SAMPLES};
 pub use stratified::StratifiedSampler;
 
+use crate::cluster::CellView;
 use crate::partition::Partition;
 use crate::registry::{Choice, Entry};
 pub(crate) use crate::rng::{mix64, Pcg32};
@@ -51,6 +52,17 @@ pub trait Sampler: Send {
     /// The sampler's clusters, for the reconstruction, when it has any.
     fn partition(&self) -> Option<&Partition> {
         None
+    }
+
+    /// The sampler's cells and clusters, for the reconstruction, when it keeps them.
+    fn cells(&self) -> Option<CellView<'_>> {
+        None
+    }
+
+    /// Whether [`Sampler::cells`] will give the cells at the end of the render (then the film
+    /// need not collect its own).
+    fn keeps_cells(&self) -> bool {
+        false
     }
 
     /// What the sampler reports for the stats file (nothing, for a non-adaptive sampler).

@@ -1,0 +1,378 @@
+//! `polynomial`: the paper's reconstruction (ALGORITHM.md section 5). Each cluster of cells is
+//! fitted with one additive Legendre polynomial over the active dims (`crate::regression`),
+//! and a pixel is the integral of the models over the cells it covers: for each cell, the
+//! share of the pixel's volume it covers times its cluster's mean over the overlap. After the
+//! cluster sampler it uses that sampler's cells and clusters; after any other sampler the film
+//! collects cells (1 pixel, no cut of the time and lens dims) and the clusters are grown from
+//! them with the sampler's code and default knobs.
+
+use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
+use crate::cluster::build::{initial_clustering, ClusterParams, Initial};
+use crate::cluster::grid::MAX_DIMS;
+use crate::cluster::{CellGrid, CellSums, CellView};
+use crate::film::{Film, Spectrum};
+use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
+use crate::sampler::ClusterSettings;
+use acr_parser::{ParamType, Result};
+use rayon::prelude::*;
+use std::sync::Mutex;
+
+/// The polynomial reconstruction.
+#[derive(Debug)]
+pub struct PolynomialFilter {
+    /// Degree per dim; None: 2 in image-only space, 1 above (the paper's finding).
+    degree: Option<u32>,
+    ridge: f64,
+    clamp: bool,
+    /// Standard errors beyond which a cell keeps its departure from the model (0: never).
+    significance: f64,
+    /// The film splats with a box of one pixel: its pixel means are the fallback for a pixel
+    /// whose cells have no usable sample.
+    kernel: BoxFilter,
+    /// Clusters fitted at each degree by the last reconstruction.
+    fitted: Mutex<[u64; MAX_DEGREE as usize + 1]>,
+}
+
+impl PolynomialFilter {
+    /// The filter with its knobs.
+    pub fn new(degree: Option<u32>, ridge: f64, clamp: bool, significance: f64) -> Self {
+        Self {
+            degree,
+            ridge,
+            clamp,
+            significance,
+            kernel: BoxFilter::new(0.5, 0.5),
+            fitted: Mutex::new([0; MAX_DEGREE as usize + 1]),
+        }
+    }
+
+    /// Clusters fitted at degree 0, 1 and 2 by the last reconstruction.
+    pub fn fitted_by_degree(&self) -> [u64; MAX_DEGREE as usize + 1] {
+        *self.fitted.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The image from `view`'s cells, clustered as given or as grown here.
+    fn reconstruct_cells(&self, film: &Film, view: CellView<'_>) -> Vec<Spectrum> {
+        let (grid, sums) = (view.grid, view.sums);
+        let grown: Option<Initial>;
+        let clustering = match view.clustering {
+            Some(c) => c,
+            None => {
+                let d = ClusterSettings::new(1);
+                let params = ClusterParams {
+                    omega: d.omega,
+                    weights: d.weights,
+                    max_cluster_cells: d.max_cluster_cells,
+                    log_features: d.log_features,
+                };
+                grown = Some(initial_clustering(grid, sums, &params));
+                &grown.as_ref().expect("just grown").clustering
+            }
+        };
+        let n = grid.dims();
+        let settings = FitSettings {
+            degree: self
+                .degree
+                .unwrap_or(if n == 2 { 2 } else { 1 })
+                .min(MAX_DEGREE),
+            ridge: self.ridge,
+            clamp: self.clamp,
+        };
+        // Each cluster's model, and the per-sample noise variance of its cells.
+        let (fits, noise): (Vec<Fit>, Vec<[f64; 3]>) = clustering
+            .clusters
+            .par_iter()
+            .map(|c| {
+                let cells: Vec<FitCell> = c
+                    .cells
+                    .iter()
+                    .map(|&i| fit_cell(grid, sums, i as usize))
+                    .collect();
+                let fit = Fit::new(&cells, n, &settings);
+                let noise = pooled_noise(sums, &c.cells);
+                (
+                    refit(fit, cells, &noise, n, &settings, self.significance),
+                    noise,
+                )
+            })
+            .unzip();
+        let mut fitted = [0u64; MAX_DEGREE as usize + 1];
+        for (c, f) in clustering.clusters.iter().zip(&fits) {
+            if !c.cells.is_empty() && !f.is_empty() {
+                fitted[f.degree() as usize] += 1;
+            }
+        }
+        *self.fitted.lock().unwrap_or_else(|e| e.into_inner()) = fitted;
+        let (w, h) = film.settings().size();
+        let stats = film.pixel_stats();
+        let of_cell = &clustering.of_cell;
+        (0..h)
+            .into_par_iter()
+            .flat_map_iter(|py| {
+                let (fits, noise, stats) = (&fits, &noise, stats);
+                (0..w).map(move |px| {
+                    let model = Model {
+                        grid,
+                        sums,
+                        of_cell,
+                        fits,
+                        noise,
+                        significance: self.significance,
+                    };
+                    model.pixel(px, py).unwrap_or_else(|| {
+                        // No usable sample in any of the pixel's cells: the film's mean.
+                        stats[(py * w + px) as usize].mean()
+                    })
+                })
+            })
+            .collect()
+    }
+}
+
+/// The fit's view of cell `i`.
+fn fit_cell(grid: &CellGrid, sums: &CellSums, i: usize) -> FitCell {
+    let (lo, hi) = grid.bounds(i);
+    let n = sums.count[i];
+    let dims = sums.dims();
+    let mut cell = FitCell {
+        lo,
+        hi,
+        m1: [0.5; MAX_DIMS],
+        m2: [1.0 / 3.0; MAX_DIMS],
+        mean: [0.0; 3],
+        weight: f64::from(n),
+    };
+    if n > 0 {
+        let inv = 1.0 / f64::from(n);
+        for d in 0..dims {
+            cell.m1[d] = f64::from(sums.offset[i * dims + d]) * inv;
+            cell.m2[d] = f64::from(sums.offset_sq[i * dims + d]) * inv;
+        }
+        cell.mean = sums.rgb[i].map(|v| f64::from(v) * inv);
+    }
+    cell
+}
+
+/// The per-sample noise variance of a cluster, per channel: the within-cell sample variance
+/// pooled over its cells (independent of how well the model fits them).
+fn pooled_noise(sums: &CellSums, cells: &[u32]) -> [f64; 3] {
+    let (mut ss, mut dof) = ([0.0f64; 3], 0.0f64);
+    for &i in cells {
+        let i = i as usize;
+        let n = f64::from(sums.count[i]);
+        if n < 2.0 {
+            continue;
+        }
+        for (acc, (&s1, &s2)) in ss.iter_mut().zip(sums.rgb[i].iter().zip(&sums.rgb_sq[i])) {
+            let (s1, s2) = (f64::from(s1), f64::from(s2));
+            *acc += (s2 - s1 * s1 / n).max(0.0);
+        }
+        dof += n - 1.0;
+    }
+    if dof > 0.0 {
+        ss.map(|v| v / dof)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// The fit again without the cells that depart from `fit` by more than `significance`
+/// standard errors in any channel, when they are fewer than half of the sampled cells: a
+/// cluster that holds cells on both sides of an edge is then fitted to its majority side, and
+/// the others keep their own means (see `Model::pixel`).
+fn refit(
+    fit: Fit,
+    mut cells: Vec<FitCell>,
+    noise: &[f64; 3],
+    dims: usize,
+    settings: &FitSettings,
+    significance: f64,
+) -> Fit {
+    if significance <= 0.0 || fit.is_empty() {
+        return fit;
+    }
+    let sampled = cells.iter().filter(|c| c.weight > 0.0).count();
+    let mut outliers = 0;
+    for c in cells.iter_mut().filter(|c| c.weight > 0.0) {
+        let v = fit.mean_over(&c.lo, &c.hi);
+        let far = (0..3).any(|ch| {
+            let se = (noise[ch] / c.weight).sqrt();
+            (c.mean[ch] - v[ch]).abs() > significance * se
+        });
+        if far {
+            c.weight = 0.0;
+            outliers += 1;
+        }
+    }
+    if outliers == 0 || 2 * outliers >= sampled {
+        return fit;
+    }
+    Fit::new(&cells, dims, settings)
+}
+
+/// The fitted clusters over the grid: what a pixel is integrated from.
+struct Model<'a> {
+    grid: &'a CellGrid,
+    sums: &'a CellSums,
+    of_cell: &'a [u32],
+    fits: &'a [Fit],
+    noise: &'a [[f64; 3]],
+    significance: f64,
+}
+
+impl Model<'_> {
+    /// Pixel (`px`, `py`) of the cropped film: the models' integral over the cells it covers,
+    /// each weighted by the share of the pixel's volume it covers. A cell whose mean departs
+    /// from its model by more than `significance` standard errors keeps that departure: the
+    /// model of a smooth field cannot follow an edge through the cell (a cluster holding the
+    /// cells on both sides of it, or a cell cut by it), and the cell's own samples then say
+    /// more than the fit. None when no covered cell's cluster had a usable sample.
+    fn pixel(&self, px: u32, py: u32) -> Option<Spectrum> {
+        let grid = self.grid;
+        let cs = grid.cell_size();
+        let shape = grid.shape();
+        let inner = grid.cells_per_image_cell();
+        let span = |p: u32, d: usize| {
+            let first = ((f64::from(p) / cs).floor() as u32).min(shape[d] - 1);
+            let last = ((f64::from(p + 1) / cs).ceil() as u32).min(shape[d]);
+            first..last.max(first + 1)
+        };
+        let (mut sum, mut weight) = ([0.0f64; 3], 0.0f64);
+        let pixel_lo = [f64::from(px), f64::from(py)];
+        for cy in span(py, 1) {
+            for cx in span(px, 0) {
+                let first = (cy as usize * shape[0] as usize + cx as usize) * inner;
+                for i in first..first + inner {
+                    let id = self.of_cell[i] as usize;
+                    let fit = &self.fits[id];
+                    if fit.is_empty() {
+                        continue;
+                    }
+                    let (cell_lo, cell_hi) = grid.bounds(i);
+                    let (mut lo, mut hi) = (cell_lo, cell_hi);
+                    let mut volume = 1.0;
+                    for d in 0..grid.dims() {
+                        if d < 2 {
+                            lo[d] = lo[d].max(pixel_lo[d]);
+                            hi[d] = hi[d].min(pixel_lo[d] + 1.0);
+                        }
+                        volume *= (hi[d] - lo[d]).max(0.0);
+                    }
+                    if volume <= 0.0 {
+                        continue;
+                    }
+                    let mut v = fit.mean_over(&lo, &hi);
+                    let count = self.sums.count[i];
+                    if self.significance > 0.0 && count > 0 {
+                        let whole = fit.mean_over(&cell_lo, &cell_hi);
+                        let n = f64::from(count);
+                        for ch in 0..3 {
+                            let mean = f64::from(self.sums.rgb[i][ch]) / n;
+                            let r = mean - whole[ch];
+                            let se = (self.noise[id][ch] / n).sqrt();
+                            if r.is_finite() && r.abs() > self.significance * se {
+                                v[ch] = (v[ch] + r).max(0.0);
+                            }
+                        }
+                    }
+                    for k in 0..3 {
+                        sum[k] += volume * v[k];
+                    }
+                    weight += volume;
+                }
+            }
+        }
+        (weight > 0.0).then(|| {
+            Spectrum::new(
+                (sum[0] / weight) as f32,
+                (sum[1] / weight) as f32,
+                (sum[2] / weight) as f32,
+            )
+        })
+    }
+}
+
+impl Filter for PolynomialFilter {
+    fn name(&self) -> &'static str {
+        "polynomial"
+    }
+
+    fn kernel(&self) -> &dyn FilterKernel {
+        &self.kernel
+    }
+
+    fn reconstruct(&self, film: &Film, from: SamplerOutput<'_>) -> Vec<Spectrum> {
+        match from.cells.or_else(|| film.cells()) {
+            Some(view) => self.reconstruct_cells(film, view),
+            // No cells anywhere (a film made without them): the pixel means.
+            None => film.pixels(),
+        }
+    }
+
+    fn report(&self) -> FilterReport {
+        FilterReport {
+            fitted_by_degree: Some(self.fitted_by_degree()),
+        }
+    }
+
+    fn cell_layout(&self) -> Option<(f64, u32)> {
+        // The cluster sampler's default cells: one per pixel, time and lens not cut.
+        Some((1.0, 1))
+    }
+}
+
+/// The registry's entry.
+pub(super) const ENTRY: Entry<FilterBuild> = Entry {
+    info: PluginInfo {
+        kind: Kind::Filter,
+        name: "polynomial",
+        doc: "the paper's reconstruction: one additive Legendre polynomial per cluster of cells, \
+              fitted by weighted least squares and integrated over each pixel",
+        params: &[
+            ParamSpec::new(
+                "degree",
+                ParamType::Integer,
+                "2 (x, y only), 1 above",
+                "degree per dim, 0 to 2 (0: each cluster's mean)",
+            ),
+            ParamSpec::new(
+                "ridge",
+                ParamType::Float,
+                "1e-6",
+                "ridge of the least squares, relative to the normal matrix's mean diagonal",
+            ),
+            ParamSpec::new(
+                "significance",
+                ParamType::Float,
+                "3",
+                "a cell whose mean departs from its cluster's model by more standard errors \
+                 than this keeps the departure (0: never)",
+            ),
+            ParamSpec::new(
+                "clamp",
+                ParamType::Bool,
+                "true",
+                "clamp values to the range of the cluster's cell means",
+            ),
+        ],
+    },
+    build,
+};
+
+fn build(c: &Choice) -> Result<Box<dyn Filter>> {
+    let p = &c.params;
+    let degree = match p.get("degree") {
+        Some(_) => Some(int_in(p, "degree", 1, 0..=i64::from(MAX_DEGREE))?),
+        None => None,
+    };
+    let ridge = float_in(p, "ridge", 1e-6, 0.0..=1.0)?;
+    let clamp = p.bool_or("clamp", true)?;
+    let significance = float_in(p, "significance", 3.0, 0.0..=1e3)?;
+    Ok(Box::new(PolynomialFilter::new(
+        degree,
+        ridge,
+        clamp,
+        significance,
+    )))
+}
