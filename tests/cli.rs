@@ -1079,3 +1079,67 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     let err = run();
     assert!(!err.contains("rendering the reference"), "{err}");
 }
+
+#[test]
+fn the_polynomial_filter_reconstructs_after_any_sampler_and_reports_its_fits() {
+    let dir = TempDir::new("polynomial");
+    let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 40, 30));
+    for sampler in ["stratified", "cluster"] {
+        let (out, stats) = (dir.join(format!("{sampler}.exr")), dir.join("p.json"));
+        let args = [
+            "--spp",
+            "4",
+            "--sampler",
+            sampler,
+            "--filter",
+            "polynomial",
+            "--stats",
+            stats.to_str().unwrap(),
+        ];
+        render_ok(&scene, &out, &args);
+        let s = read_stats(&stats);
+        assert_eq!(s["filter"], "polynomial");
+        let fitted: Vec<u64> = s["fitted_by_degree"]
+            .as_array()
+            .unwrap_or_else(|| panic!("fitted_by_degree: {s}"))
+            .iter()
+            .map(|v| v.as_u64().unwrap())
+            .collect();
+        assert_eq!(fitted.len(), 3);
+        // 5D: degree 1 by default, so no cluster at degree 2, and some fitted at all.
+        assert!(
+            fitted[0] + fitted[1] > 0 && fitted[2] == 0,
+            "{sampler}: {fitted:?}"
+        );
+        let img = read_image(&out, false).unwrap();
+        assert_eq!(img.pixels.len(), 40 * 30);
+        assert!(img
+            .pixels
+            .iter()
+            .all(|c| c.is_finite() && c.min_element() >= 0.0));
+        assert!(
+            img.pixels.iter().any(|c| c.max_element() > 0.0),
+            "{sampler}: black image"
+        );
+    }
+    // A bad knob is a located error.
+    let out = dir.join("bad.exr");
+    let o = acr_command([
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--filter",
+        "polynomial",
+        "--set",
+        "filter.degree=5",
+    ])
+    .output()
+    .unwrap();
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("degree 5 is out of range"),
+        "{}",
+        stderr(&o)
+    );
+}
