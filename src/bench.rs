@@ -394,11 +394,26 @@ pub struct BenchOptions {
     pub commit: String,
 }
 
-/// Equal-time runs may take up to this many times the budget's samples per pixel; the time
-/// limit stops them first. A sampler that fixes its pattern from its budget (stratified's
-/// strata) spreads it over this many samples, so the cap is kept small: a method more than 4x
-/// faster than the first stops at the cap, and its row shows it (spp reached = 4 x budget).
+/// Equal-time runs take the samples per pixel that the method's own equal-spp run says fit in
+/// the first method's time, at most this many times the budget, with that time as a limit. A
+/// sampler that plans from its budget (stratified's strata, the cluster sampler's stages)
+/// then plans for what it will reach: given a larger budget and stopped by the clock, the
+/// cluster sampler would spend the time in its first stage and never adapt.
 const EQUAL_TIME_SPP_FACTOR: u32 = 4;
+
+/// The equal-time budget: `spp` scaled by the first method's seconds over this method's own
+/// at `spp`, within 1 and `EQUAL_TIME_SPP_FACTOR` x `spp`.
+fn equal_time_spp(spp: u32, baseline: Option<f64>, own: Option<f64>) -> u32 {
+    let cap = spp
+        .saturating_mul(EQUAL_TIME_SPP_FACTOR)
+        .min(crate::render::MAX_SPP);
+    match (baseline, own) {
+        (Some(base), Some(own)) if own > 0.0 && base > 0.0 => {
+            ((f64::from(spp) * base / own).round() as u32).clamp(1, cap)
+        }
+        _ => cap,
+    }
+}
 
 /// Runs the whole manifest; returns the rows (failed runs included).
 pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<Vec<Row>, String> {
@@ -431,6 +446,7 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<Vec<Row>, 
         for &spp in &m.budgets.spp {
             let mut baseline_seconds = None;
             for (k, method) in m.methods.iter().enumerate() {
+                let mut own_seconds = None;
                 let modes: &[Mode] = if k > 0 && m.budgets.equal_time {
                     &[Mode::EqualSpp, Mode::EqualTime]
                 } else {
@@ -453,8 +469,7 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<Vec<Row>, 
                             let (run_spp, limit) = match mode {
                                 Mode::EqualSpp => (spp, None),
                                 Mode::EqualTime => (
-                                    spp.saturating_mul(EQUAL_TIME_SPP_FACTOR)
-                                        .min(crate::render::MAX_SPP),
+                                    equal_time_spp(spp, baseline_seconds, own_seconds),
                                     baseline_seconds,
                                 ),
                             };
@@ -473,6 +488,9 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<Vec<Row>, 
                     };
                     if k == 0 {
                         baseline_seconds = outcome.as_ref().ok().map(|r| r.seconds);
+                    }
+                    if mode == Mode::EqualSpp {
+                        own_seconds = outcome.as_ref().ok().map(|r| r.seconds);
                     }
                     match &outcome {
                         Ok(r) => eprintln!(
@@ -673,7 +691,7 @@ pub fn report_markdown(m: &Manifest, manifest: &Path, opts: &BenchOptions, rows:
     let _ = writeln!(s, "- seed: {}", m.seed);
     let _ = writeln!(
         s,
-        "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given `--time-limit` = the first method's seconds at that budget (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
+        "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds as `--time-limit` (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
         m.methods[0].label
     );
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
@@ -900,6 +918,19 @@ pub fn plot_scene(
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn equal_time_budgets_scale_with_the_method_s_own_speed() {
+        // Twice as fast as the first method: twice the spp; half as fast: half.
+        assert_eq!(equal_time_spp(8, Some(2.0), Some(1.0)), 16);
+        assert_eq!(equal_time_spp(8, Some(1.0), Some(2.0)), 4);
+        // Within 1 and 4x the budget.
+        assert_eq!(equal_time_spp(8, Some(100.0), Some(1.0)), 32);
+        assert_eq!(equal_time_spp(8, Some(0.01), Some(1.0)), 1);
+        // No timing to go by: the cap, and the time limit decides.
+        assert_eq!(equal_time_spp(8, Some(1.0), None), 32);
+    }
+
     use super::*;
 
     #[test]
