@@ -16,10 +16,21 @@ pub const AOV_NAMES: &[&str] = &["spp", "variance", "clusters"];
 /// One requested AOV.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct AovRequest {
-    /// Which (`spp`, `variance`).
+    /// Which (`spp`, `variance`, `clusters`).
     pub name: String,
     /// Where to write it.
     pub path: PathBuf,
+}
+
+impl AovRequest {
+    /// The file's extension, lower case ("" when none): it picks the format.
+    fn extension(&self) -> String {
+        self.path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase()
+    }
 }
 
 /// Parses `NAME=FILE[,NAME=FILE...]` as `--aov` takes it.
@@ -74,12 +85,7 @@ pub fn write_aov(
         return write_clusters(req, p);
     }
     let values = aov_values(&req.name, stats);
-    let ext = req
-        .path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
+    let ext = req.extension();
     if ext != "png" {
         write_image(
             &req.path,
@@ -144,12 +150,7 @@ pub fn cluster_colour(id: u32) -> [u8; 3] {
 /// Writes the partition: a PNG of cluster colours with borders, or the ids as values.
 fn write_clusters(req: &AovRequest, p: &Partition) -> Result<String, String> {
     let (w, h) = (p.width as usize, p.height as usize);
-    let ext = req
-        .path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
+    let ext = req.extension();
     let count = p.clusters();
     if ext != "png" {
         let pixels = p

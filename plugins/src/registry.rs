@@ -348,18 +348,7 @@ pub(crate) fn float_in(
     range: std::ops::RangeInclusive<f64>,
 ) -> Result<f64> {
     let v = params.float_or(name, default)?;
-    if !range.contains(&v) {
-        let p = params.get(name).expect("a default lies in range");
-        return Err(Error::at(
-            &p.loc,
-            format!(
-                "{name} {v} is out of range ({} to {})",
-                range.start(),
-                range.end()
-            ),
-        ));
-    }
-    Ok(v)
+    in_range(params, name, v, range)
 }
 
 /// An integer parameter that must lie in `range`, or an error at its location.
@@ -370,18 +359,28 @@ pub(crate) fn int_in(
     range: std::ops::RangeInclusive<i64>,
 ) -> Result<u32> {
     let v = i64::from(params.int_or(name, default)?);
-    if !range.contains(&v) {
-        let p = params.get(name).expect("a default lies in range");
-        return Err(Error::at(
-            &p.loc,
-            format!(
-                "{name} {v} is out of range ({} to {})",
-                range.start(),
-                range.end()
-            ),
-        ));
+    in_range(params, name, v, range).map(|v| v as u32)
+}
+
+/// `v`, the value of parameter `name`, if within `range`; else an error at its location.
+fn in_range<T: PartialOrd + fmt::Display>(
+    params: &ParamList,
+    name: &str,
+    v: T,
+    range: std::ops::RangeInclusive<T>,
+) -> Result<T> {
+    if range.contains(&v) {
+        return Ok(v);
     }
-    Ok(v as u32)
+    let p = params.get(name).expect("a default lies in range");
+    Err(Error::at(
+        &p.loc,
+        format!(
+            "{name} {v} is out of range ({} to {})",
+            range.start(),
+            range.end()
+        ),
+    ))
 }
 
 #[cfg(test)]
