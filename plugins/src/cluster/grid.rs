@@ -275,6 +275,25 @@ impl CellGrid {
         })
     }
 
+    /// Cells per pixel side when a pixel holds a whole number of cells (cellsize 1, 1/2,
+    /// 1/3...): then a cell lies in one pixel and [`Self::pixel_of_cell`] needs no offsets.
+    pub fn cells_per_pixel(&self) -> Option<u32> {
+        let k = 1.0 / self.cell_size;
+        (self.cell_size <= 1.0 && k.fract() == 0.0).then_some(k as u32)
+    }
+
+    /// The pixel holding cell `i` when a pixel holds `per_pixel` cells per side (from
+    /// [`Self::cells_per_pixel`]).
+    #[inline]
+    pub fn pixel_of_cell(&self, i: usize, per_pixel: u32) -> [u32; 2] {
+        let image = (i / self.stride[0]) as u32;
+        let (cx, cy) = (image % self.shape[0], image / self.shape[0]);
+        [
+            self.space.x0 + cx / per_pixel,
+            self.space.y0 + cy / per_pixel,
+        ]
+    }
+
     /// The image cell (x, y cell coordinates) holding the centre of pixel `(px, py)`, given
     /// relative to the space's corner.
     pub fn image_cell_of_pixel(&self, px: u32, py: u32) -> (u32, u32) {
@@ -422,6 +441,26 @@ mod tests {
                     }
                     assert!(q.pixel[0] < 10 + w && q.pixel[1] < 20 + h);
                     assert_eq!(g.pixel(i, &u), q.pixel);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_cell_inside_one_pixel_knows_its_pixel() {
+        for (cs, per) in [
+            (1.0, Some(1)),
+            (0.5, Some(2)),
+            (0.25, Some(4)),
+            (1.5, None),
+            (0.75, None),
+        ] {
+            let g = CellGrid::new(space(6, 4, true, false), cs, 2);
+            assert_eq!(g.cells_per_pixel(), per, "cellsize {cs}");
+            let Some(per) = per else { continue };
+            for i in 0..g.len() {
+                for u in [[0.0; MAX_DIMS], [0.999; MAX_DIMS]] {
+                    assert_eq!(g.pixel_of_cell(i, per), g.pixel(i, &u), "cell {i}");
                 }
             }
         }

@@ -13,7 +13,7 @@ use super::{
 };
 use crate::cluster::build::{initial_clustering, ClusterParams};
 use crate::cluster::clusters::UNASSIGNED;
-use crate::cluster::features::{level, raw};
+use crate::cluster::features::{level, raw, Feature};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::queue::{BucketQueue, Queued};
 use crate::cluster::{CellGrid, CellSums, CellView, Cluster, Clustering, FeatureScale};
@@ -147,6 +147,8 @@ pub struct ClusterSampler {
     round_clusters: Vec<u32>,
     /// The cell and in-cell offsets of each point of the round under way, in batch order.
     round_cells: Vec<(u32, [f32; MAX_DIMS])>,
+    /// The pixel index of each point drawn in a round, in draw order (reused).
+    drawn: Vec<u32>,
     /// Cells that received samples since the last update.
     touched: Vec<u32>,
     stamp: Vec<u32>,
@@ -190,6 +192,7 @@ impl ClusterSampler {
             planned: Vec::new(),
             round_clusters: Vec::new(),
             round_cells: Vec::new(),
+            drawn: Vec::new(),
             touched: Vec::new(),
             stamp: vec![0; cells],
             generation: 0,
@@ -330,44 +333,118 @@ impl ClusterSampler {
             self.queue.push(priority, e);
         }
         let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
+        if self.settings.even_pixels {
+            self.draw_pixels(&picks, &mut rng, out);
+            let (init, grid) = (&self.init, &self.grid);
+            let seed = init.seed();
+            self.round_cells.resize(out.len(), (0, [0.0; MAX_DIMS]));
+            out.par_iter_mut()
+                .zip(self.round_cells.par_iter_mut())
+                .with_min_len(256)
+                .for_each(|(q, slot)| {
+                    *q = init.point(q.pixel, q.index, Scramble::of(q.pixel, seed));
+                    let (cell, off) = grid.locate(q);
+                    *slot = (cell as u32, off);
+                });
+        } else {
+            self.draw_cells(&picks, &mut rng, out);
+        }
+        self.round_clusters = picks.iter().map(|&(id, _)| id).collect();
+        self.remaining -= planned_total;
+        self.rounds += 1;
+    }
+
+    /// The systematic sample of `k` slots over `m` cells from a random start: `k` samples
+    /// cover a cluster's cells evenly rather than by chance.
+    #[inline]
+    fn slots(rng: &mut Pcg32, m: usize, k: u64) -> impl Iterator<Item = usize> {
+        let start = f64::from(rng.next_f32()) * m as f64;
+        (0..k).map(move |j| ((start + j as f64 * m as f64 / k as f64) as usize) % m)
+    }
+
+    /// Draws the round's pixels (evenpixels): each pick's samples go to pixels of its cells,
+    /// and each gets the pixel's next index; `out` holds them sorted by row, the rest of each
+    /// point left to be made.
+    fn draw_pixels(&mut self, picks: &[(u32, u64)], rng: &mut Pcg32, out: &mut Vec<SamplePoint>) {
         let clustering = self.clustering.as_ref().expect("clustered");
-        let n = self.grid.dims();
-        let mut points: Vec<(SamplePoint, u32, [f32; MAX_DIMS])> =
-            Vec::with_capacity(planned_total as usize);
-        for &(id, k) in &picks {
+        let per_pixel = self.grid.cells_per_pixel();
+        let width = self.space.width() as usize;
+        let rows = self.space.height() as usize;
+        let mut drawn = std::mem::take(&mut self.drawn);
+        drawn.clear();
+        let mut start = vec![0usize; rows + 1];
+        for &(id, k) in picks {
             self.planned[id as usize] = 0;
             let cells = &clustering.clusters[id as usize].cells;
-            let m = cells.len() as f64;
-            // Systematic sampling over the cluster's cells from a random start: k samples
-            // cover the cells evenly rather than by chance.
-            let start = f64::from(rng.next_f32()) * m;
-            for j in 0..k {
-                let slot = ((start + j as f64 * m / k as f64) as usize) % cells.len();
+            for slot in Self::slots(rng, cells.len(), k) {
+                let cell = cells[slot] as usize;
+                let pixel = match per_pixel {
+                    Some(per) => self.grid.pixel_of_cell(cell, per),
+                    None => {
+                        let mut u = [0.5f32; MAX_DIMS];
+                        u[0] = rng.next_f32();
+                        u[1] = rng.next_f32();
+                        self.grid.pixel(cell, &u)
+                    }
+                };
+                let p = self.pixel_index(pixel);
+                drawn.push(p as u32);
+                start[p / width + 1] += 1;
+            }
+        }
+        // The film takes samples sorted by row: a stable counting sort, O(n). A pixel's
+        // indices follow the draw order, as the sort is stable.
+        for r in 0..rows {
+            start[r + 1] += start[r];
+        }
+        let blank = SamplePoint {
+            pixel: [0; 2],
+            index: 0,
+            film: [0.0; 2],
+            time: 0.5,
+            lens: [0.5; 2],
+        };
+        out.clear();
+        out.resize(drawn.len(), blank);
+        let (x0, y0) = (self.space.x0, self.space.y0);
+        for &p in &drawn {
+            let p = p as usize;
+            let r = &mut start[p / width];
+            let index = &mut self.pixel_count[p];
+            out[*r] = SamplePoint {
+                pixel: [x0 + (p % width) as u32, y0 + (p / width) as u32],
+                index: *index,
+                ..blank
+            };
+            *index += 1;
+            *r += 1;
+        }
+        self.drawn = drawn;
+    }
+
+    /// Draws the round's points inside the chosen cells themselves (evenpixels false): each a
+    /// uniform point in its cell; `out` holds them sorted by row and `round_cells` their cells.
+    fn draw_cells(&mut self, picks: &[(u32, u64)], rng: &mut Pcg32, out: &mut Vec<SamplePoint>) {
+        let clustering = self.clustering.as_ref().expect("clustered");
+        let n = self.grid.dims();
+        let mut points: Vec<(SamplePoint, u32, [f32; MAX_DIMS])> = Vec::new();
+        for &(id, k) in picks {
+            self.planned[id as usize] = 0;
+            let cells = &clustering.clusters[id as usize].cells;
+            for slot in Self::slots(rng, cells.len(), k) {
                 let mut u = [0.5f32; MAX_DIMS];
                 for v in &mut u[..n] {
                     *v = rng.next_f32();
                 }
                 let cell = cells[slot];
-                let mut q = if self.settings.even_pixels {
-                    // Only the pixel is chosen here; the point is the pixel's next one, made
-                    // below in parallel.
-                    SamplePoint {
-                        pixel: self.grid.pixel(cell as usize, &u),
-                        index: 0,
-                        film: [0.0; 2],
-                        time: 0.5,
-                        lens: [0.5; 2],
-                    }
-                } else {
-                    self.grid.point(cell as usize, &u)
-                };
+                let mut q = self.grid.point(cell as usize, &u);
                 let p = self.pixel_index(q.pixel);
                 q.index = self.pixel_count[p];
                 self.pixel_count[p] += 1;
                 points.push((q, cell, u));
             }
         }
-        // The film takes samples sorted by row: a stable counting sort, O(n).
+        // Sorted by row for the film: a stable counting sort, O(n).
         let (y0, rows) = (self.space.y0, self.space.height() as usize);
         let mut start = vec![0usize; rows + 1];
         for (q, _, _) in &points {
@@ -388,21 +465,6 @@ impl ClusterSampler {
             self.round_cells[*r] = (cell, u);
             *r += 1;
         }
-        if self.settings.even_pixels {
-            let (init, grid) = (&self.init, &self.grid);
-            let seed = init.seed();
-            out.par_iter_mut()
-                .zip(self.round_cells.par_iter_mut())
-                .with_min_len(256)
-                .for_each(|(q, slot)| {
-                    *q = init.point(q.pixel, q.index, Scramble::of(q.pixel, seed));
-                    let (cell, off) = grid.locate(q);
-                    *slot = (cell as u32, off);
-                });
-        }
-        self.round_clusters = picks.iter().map(|&(id, _)| id).collect();
-        self.remaining -= planned_total;
-        self.rounds += 1;
     }
 
     /// Table 1's UpdateCluster after a round: new levels and features for the cells that got
@@ -446,26 +508,33 @@ impl ClusterSampler {
         let mut nbrs = Vec::new();
         let (grid, sums) = (&self.grid, &self.sums);
         let levels = &self.levels;
-        let raws: Vec<(f32, f32)> = dirty
-            .par_iter()
-            .map(|&i| raw(grid, sums, levels, i as usize))
-            .collect();
         let scale = self.scale.expect("clustered");
-        let clustering = self.clustering.as_mut().expect("clustered");
         let n = grid.dims();
+        let (g_old, s_old, level_old) = (&self.g, &self.s, &self.feature_level);
+        // New raw features, and the old and new feature vectors of the cells whose features changed,
+        // made in parallel: the moves below are the only serial part.
+        let changes: Vec<Option<(u32, f32, f32, Feature, Feature)>> = dirty
+            .par_iter()
+            .map(|&i| {
+                let i = i as usize;
+                let (g, s) = raw(grid, sums, levels, i);
+                let level = levels[i];
+                if g == g_old[i] && s == s_old[i] && level == level_old[i] {
+                    return None;
+                }
+                let c = grid.coords(i);
+                let old = scale.feature(n, &c, g_old[i], s_old[i], level_old[i]);
+                let new = scale.feature(n, &c, g, s, level);
+                Some((i as u32, g, s, old, new))
+            })
+            .collect();
+        let clustering = self.clustering.as_mut().expect("clustered");
         let mut changed: Vec<u32> = std::mem::take(&mut self.round_clusters);
-        for (&i, (g, s)) in dirty.iter().zip(raws) {
+        for (i, g, s, old, new) in changes.into_iter().flatten() {
             let i = i as usize;
-            let level = self.levels[i];
-            if g == self.g[i] && s == self.s[i] && level == self.feature_level[i] {
-                continue;
-            }
-            let c = grid.coords(i);
-            let old = scale.feature(n, &c, self.g[i], self.s[i], self.feature_level[i]);
-            let new = scale.feature(n, &c, g, s, level);
             self.g[i] = g;
             self.s[i] = s;
-            self.feature_level[i] = level;
+            self.feature_level[i] = self.levels[i];
             let (a, b) =
                 clustering.update(grid, i, &old, &new, u64::from(sums.count[i]), &mut nbrs);
             changed.push(a);
