@@ -110,6 +110,15 @@ impl ClusterSettings {
     }
 }
 
+/// A cell's new raw features and its feature vector before and after.
+struct FeatureChange {
+    cell: u32,
+    g: f32,
+    s: f32,
+    old: Feature,
+    new: Feature,
+}
+
 /// Where the sampler is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
@@ -513,7 +522,7 @@ impl ClusterSampler {
         let (g_old, s_old, level_old) = (&self.g, &self.s, &self.feature_level);
         // New raw features, and the old and new feature vectors of the cells whose features changed,
         // made in parallel: the moves below are the only serial part.
-        let changes: Vec<Option<(u32, f32, f32, Feature, Feature)>> = dirty
+        let changes: Vec<Option<FeatureChange>> = dirty
             .par_iter()
             .map(|&i| {
                 let i = i as usize;
@@ -525,13 +534,26 @@ impl ClusterSampler {
                 let c = grid.coords(i);
                 let old = scale.feature(n, &c, g_old[i], s_old[i], level_old[i]);
                 let new = scale.feature(n, &c, g, s, level);
-                Some((i as u32, g, s, old, new))
+                Some(FeatureChange {
+                    cell: i as u32,
+                    g,
+                    s,
+                    old,
+                    new,
+                })
             })
             .collect();
         let clustering = self.clustering.as_mut().expect("clustered");
         let mut changed: Vec<u32> = std::mem::take(&mut self.round_clusters);
-        for (i, g, s, old, new) in changes.into_iter().flatten() {
-            let i = i as usize;
+        for FeatureChange {
+            cell,
+            g,
+            s,
+            old,
+            new,
+        } in changes.into_iter().flatten()
+        {
+            let i = cell as usize;
             self.g[i] = g;
             self.s[i] = s;
             self.feature_level[i] = self.levels[i];
