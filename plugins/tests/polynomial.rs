@@ -7,7 +7,7 @@ use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::SamplerOutput;
 use acr_plugins::rng::mix64;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
-use acr_plugins::{Choice, Filter, Sampler, SamplerSetup, FILTERS, SAMPLERS};
+use acr_plugins::{Choice, Filter, Sampler, SamplerSetup, Setting, FILTERS, SAMPLERS};
 use glam::{Vec2, Vec3};
 
 const W: u32 = 64;
@@ -64,38 +64,42 @@ fn sampler(name: &str, spp: u32, seed: u64) -> Box<dyn Sampler> {
     (e.build)(&Choice::new(None, name, None), &setup).unwrap()
 }
 
+/// The image `f` makes from the samples of `s` on the field.
+fn render(mut s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
+    let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
+    if let Some((cell_size, bins)) = f.cell_layout() {
+        if !s.keeps_cells() {
+            film.collect_cells(CellGrid::new(space(), cell_size, bins));
+        }
+    }
+    let mut batch = Vec::new();
+    while s.next_batch(&mut batch) {
+        let radiance: Vec<[f32; 3]> = batch.iter().map(|q| [field(q); 3]).collect();
+        s.observe(&batch, &radiance);
+        film.add_points(&batch, &radiance);
+        let samples: Vec<(Vec2, Vec3)> = batch
+            .iter()
+            .zip(&radiance)
+            .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
+            .collect();
+        film.add_samples(&samples);
+    }
+    f.reconstruct(
+        &film,
+        SamplerOutput {
+            partition: s.partition(),
+            cells: s.cells(),
+        },
+    )
+}
+
 /// RMS error against the exact pixels of `sampler_name` + `filter_name` at `spp`, over seeds,
 /// and the error over the edge's columns alone.
 fn rms(sampler_name: &str, filter_name: &str, spp: u32) -> (f64, f64) {
     let f = filter(filter_name);
     let (mut all, mut edge, mut n, mut ne) = (0.0, 0.0, 0usize, 0usize);
     for seed in 1..=4 {
-        let mut s = sampler(sampler_name, spp, seed);
-        let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
-        if let Some((cell_size, bins)) = f.cell_layout() {
-            if !s.keeps_cells() {
-                film.collect_cells(CellGrid::new(space(), cell_size, bins));
-            }
-        }
-        let mut batch = Vec::new();
-        while s.next_batch(&mut batch) {
-            let radiance: Vec<[f32; 3]> = batch.iter().map(|q| [field(q); 3]).collect();
-            s.observe(&batch, &radiance);
-            film.add_points(&batch, &radiance);
-            let samples: Vec<(Vec2, Vec3)> = batch
-                .iter()
-                .zip(&radiance)
-                .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
-                .collect();
-            film.add_samples(&samples);
-        }
-        let img = f.reconstruct(
-            &film,
-            SamplerOutput {
-                partition: s.partition(),
-                cells: s.cells(),
-            },
-        );
+        let img = render(sampler(sampler_name, spp, seed), f.as_ref());
         for py in 0..H {
             for px in 0..W {
                 let v = f64::from(img[(py * W + px) as usize].x);
@@ -160,4 +164,34 @@ fn the_polynomial_beats_box_and_gaussian_on_a_noisy_step_edge() {
             );
         }
     }
+}
+
+#[test]
+fn the_filter_grows_its_own_clusters_when_given_omega() {
+    // After the cluster sampler the fit uses the sampler's clusters, unless the filter is given
+    // its own omega or size bound: then it grows its own from the same cells.
+    let default = filter("polynomial");
+    let e = FILTERS
+        .iter()
+        .find(|e| e.info.name == "polynomial")
+        .unwrap();
+    let mut c = Choice::new(None, "polynomial", None);
+    for arg in ["filter.omega=0.1", "filter.maxclustercells=256"] {
+        Setting::parse(arg).unwrap().apply(&e.info, &mut c).unwrap();
+    }
+    let own = (e.build)(&c).unwrap();
+    let fitted = |f: &dyn Filter| -> u64 { f.report().fitted_by_degree.unwrap().iter().sum() };
+    let a = render(sampler("cluster", 16, 3), default.as_ref());
+    let n_default = fitted(default.as_ref());
+    let b = render(sampler("cluster", 16, 3), own.as_ref());
+    let n_own = fitted(own.as_ref());
+    println!("clusters fitted: the sampler's {n_default}, the filter's own {n_own}");
+    assert!(
+        n_own > 0 && 2 * n_own < n_default,
+        "{n_own} against {n_default}"
+    );
+    for v in a.iter().chain(&b) {
+        assert!(v.is_finite() && v.min_element() >= 0.0);
+    }
+    assert_ne!(a, b, "own clusters change the image");
 }

@@ -32,6 +32,9 @@ pub struct PolynomialFilter {
     kernel: BoxFilter,
     /// Clusters fitted at each degree by the last reconstruction.
     fitted: Mutex<[u64; MAX_DEGREE as usize + 1]>,
+    /// The fit's own clustering (ω, most cells), grown from the cells even where the sampler
+    /// gives one; None: the sampler's clusters, or the sampler's defaults.
+    own: Option<(f64, u32)>,
 }
 
 impl PolynomialFilter {
@@ -44,7 +47,15 @@ impl PolynomialFilter {
             significance,
             kernel: BoxFilter::new(0.5, 0.5),
             fitted: Mutex::new([0; MAX_DEGREE as usize + 1]),
+            own: None,
         }
+    }
+
+    /// Fits clusters grown here with `omega` and at most `max_cells` cells, whatever the
+    /// sampler's clusters.
+    pub fn with_own_clusters(mut self, omega: f64, max_cells: u32) -> Self {
+        self.own = Some((omega, max_cells));
+        self
     }
 
     /// Clusters fitted at degree 0, 1 and 2 by the last reconstruction.
@@ -56,14 +67,15 @@ impl PolynomialFilter {
     fn reconstruct_cells(&self, film: &Film, view: CellView<'_>) -> Vec<Spectrum> {
         let (grid, sums) = (view.grid, view.sums);
         let grown: Option<Initial>;
-        let clustering = match view.clustering {
-            Some(c) => c,
-            None => {
+        let clustering = match (view.clustering, self.own) {
+            (Some(c), None) => c,
+            (_, own) => {
                 let d = ClusterSettings::new(1);
+                let (omega, max_cluster_cells) = own.unwrap_or((d.omega, d.max_cluster_cells));
                 let params = ClusterParams {
-                    omega: d.omega,
+                    omega,
                     weights: d.weights,
-                    max_cluster_cells: d.max_cluster_cells,
+                    max_cluster_cells,
                     log_features: d.log_features,
                 };
                 grown = Some(initial_clustering(grid, sums, &params));
@@ -350,6 +362,18 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
                  than this keeps the departure (0: never)",
             ),
             ParamSpec::new(
+                "omega",
+                ParamType::Float,
+                "the sampler's",
+                "grow the fit's own clusters with this ω of eq. 10 (smaller: larger clusters)",
+            ),
+            ParamSpec::new(
+                "maxclustercells",
+                ParamType::Integer,
+                "the sampler's",
+                "most cells in one of the fit's own clusters",
+            ),
+            ParamSpec::new(
                 "clamp",
                 ParamType::Bool,
                 "true",
@@ -369,10 +393,11 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     let ridge = float_in(p, "ridge", 1e-6, 0.0..=1.0)?;
     let clamp = p.bool_or("clamp", true)?;
     let significance = float_in(p, "significance", 3.0, 0.0..=1e3)?;
-    Ok(Box::new(PolynomialFilter::new(
-        degree,
-        ridge,
-        clamp,
-        significance,
-    )))
+    let mut f = PolynomialFilter::new(degree, ridge, clamp, significance);
+    if p.get("omega").is_some() || p.get("maxclustercells").is_some() {
+        let omega = float_in(p, "omega", 0.7, 1e-3..=1e3)?;
+        let max_cells = int_in(p, "maxclustercells", 64, 1..=1 << 24)?;
+        f = f.with_own_clusters(omega, max_cells);
+    }
+    Ok(Box::new(f))
 }
