@@ -251,13 +251,7 @@ fn bvh(c: &mut Criterion) {
 
 /// The rendering space of the sampler and film benchmarks: the whole `RES` x `RES` image.
 fn space(dims: Dims) -> RenderingSpace {
-    RenderingSpace {
-        x0: 0,
-        x1: RES,
-        y0: 0,
-        y1: RES,
-        dims,
-    }
+    RenderingSpace::whole(RES, RES, dims)
 }
 
 /// Builds sampler `name` through the registry, as the renderer does, at `SPP` samples per pixel.

@@ -132,19 +132,33 @@ fn dims(stats: &serde_json::Value) -> Vec<String> {
         .collect()
 }
 
-/// Renders `scene` with `args` after the output and checks the run succeeded.
-fn render_ok(scene: &Path, output: &Path, args: &[&str]) -> Output {
-    let mut all: Vec<&OsStr> = vec![
+/// `render SCENE -o OUTPUT`, the start of every render command line here.
+fn render_args<'a>(scene: &'a Path, output: &'a Path) -> Vec<&'a OsStr> {
+    vec![
         "render".as_ref(),
         scene.as_os_str(),
         "-o".as_ref(),
         output.as_os_str(),
-        "--quiet".as_ref(),
-    ];
+    ]
+}
+
+/// Renders `scene` with `args` after the output and checks the run succeeded.
+fn render_ok(scene: &Path, output: &Path, args: &[&str]) -> Output {
+    let mut all = render_args(scene, output);
+    all.push("--quiet".as_ref());
     all.extend(args.iter().map(OsStr::new));
     let o = acr(&all);
     assert!(o.status.success(), "acr {all:?}: {}", stderr(&o));
     o
+}
+
+/// Renders `scene` with `args` after the output and checks it fails cleanly saying `message`.
+fn render_fails(scene: &Path, output: &Path, args: &[&str], message: &str) {
+    let mut all = render_args(scene, output);
+    all.extend(args.iter().map(OsStr::new));
+    let o = acr(&all);
+    assert_clean_failure(&o, &format!("acr {all:?}"));
+    assert!(stderr(&o).contains(message), "{}", stderr(&o));
 }
 
 #[test]
@@ -972,38 +986,23 @@ fn the_cluster_sampler_reports_clusters_and_draws_them() {
     let colours: std::collections::HashSet<[u8; 3]> = png.pixels().map(|p| p.0).collect();
     assert!(colours.len() > 2, "{} colours", colours.len());
     // Another sampler has no clusters to draw: refused before rendering.
-    let o = acr_command([
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        dir.join("x.exr").to_str().unwrap(),
-        "--sampler",
-        "sobol",
-        "--aov",
-        &format!("clusters={}", clusters.display()),
-    ])
-    .output()
-    .unwrap();
-    assert!(!o.status.success());
-    assert!(stderr(&o).contains("makes no clusters"), "{}", stderr(&o));
+    render_fails(
+        &scene,
+        &dir.join("x.exr"),
+        &[
+            "--sampler",
+            "sobol",
+            "--aov",
+            &format!("clusters={}", clusters.display()),
+        ],
+        "makes no clusters",
+    );
     // A knob out of range is a located error.
-    let o = acr_command([
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        dir.join("x.exr").to_str().unwrap(),
-        "--sampler",
-        "cluster",
-        "--set",
-        "sampler.omega=-1",
-    ])
-    .output()
-    .unwrap();
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("omega -1 is out of range"),
-        "{}",
-        stderr(&o)
+    render_fails(
+        &scene,
+        &dir.join("x.exr"),
+        &["--sampler", "cluster", "--set", "sampler.omega=-1"],
+        "omega -1 is out of range",
     );
 }
 
@@ -1123,23 +1122,10 @@ fn the_polynomial_filter_reconstructs_after_any_sampler_and_reports_its_fits() {
         );
     }
     // A bad knob is a located error.
-    let out = dir.join("bad.exr");
-    let o = acr_command([
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--filter",
-        "polynomial",
-        "--set",
-        "filter.degree=5",
-    ])
-    .output()
-    .unwrap();
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("degree 5 is out of range"),
-        "{}",
-        stderr(&o)
+    render_fails(
+        &scene,
+        &dir.join("bad.exr"),
+        &["--filter", "polynomial", "--set", "filter.degree=5"],
+        "degree 5 is out of range",
     );
 }

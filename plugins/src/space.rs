@@ -46,6 +46,17 @@ pub struct RenderingSpace {
 }
 
 impl RenderingSpace {
+    /// The whole of a `width` x `height` image, no crop, with `dims` beyond x and y.
+    pub fn whole(width: u32, height: u32, dims: Dims) -> Self {
+        Self {
+            x0: 0,
+            x1: width,
+            y0: 0,
+            y1: height,
+            dims,
+        }
+    }
+
     /// Pixel columns rendered.
     pub fn width(&self) -> u32 {
         self.x1.saturating_sub(self.x0)

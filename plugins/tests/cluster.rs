@@ -51,16 +51,6 @@ fn defocus_4d(q: &SamplePoint) -> f32 {
     side(f64::from(q.film[0]) >= edge_4d(f64::from(q.lens[0])), q)
 }
 
-fn space(w: u32, h: u32, dims: Dims) -> RenderingSpace {
-    RenderingSpace {
-        x0: 0,
-        x1: w,
-        y0: 0,
-        y1: h,
-        dims,
-    }
-}
-
 /// Runs the sampler to the end on `field`; every point, in order.
 fn run(s: &mut ClusterSampler, field: Field) -> Vec<SamplePoint> {
     let mut all = Vec::new();
@@ -111,6 +101,13 @@ fn interval_side(x0: f64, x1: f64, e0: f64, e1: f64) -> Side {
     } else {
         Side::Across
     }
+}
+
+/// Side of cell `c` (x, y and one bin of 2 along a third dim) against an edge at x = `edge(w)`
+/// that moves with that dim's value w.
+fn moving_edge_side(c: &[u32], edge: fn(f64) -> f64) -> Side {
+    let (w0, w1) = (f64::from(c[2]) / 2.0, f64::from(c[2] + 1) / 2.0);
+    interval_side(f64::from(c[0]), f64::from(c[0] + 1), edge(w0), edge(w1))
 }
 
 /// Mean samples per pixel over the pixels whose column satisfies `near`, and over the rest.
@@ -172,7 +169,7 @@ struct Case {
 
 fn check(case: &Case) {
     let (w, h, spp) = (64, 48, 8);
-    let sp = space(w, h, case.dims);
+    let sp = RenderingSpace::whole(w, h, case.dims);
     // Cells cut in two along t, u and v (the default, 1, keeps cells to the image): the
     // clusters are multidimensional here.
     let settings = ClusterSettings {
@@ -253,15 +250,7 @@ fn moving_edge_3d() {
             lens: false,
         },
         field: moving_3d,
-        side: |c| {
-            let (t0, t1) = (f64::from(c[2]) / 2.0, f64::from(c[2] + 1) / 2.0);
-            interval_side(
-                f64::from(c[0]),
-                f64::from(c[0] + 1),
-                edge_3d(t0),
-                edge_3d(t1),
-            )
-        },
+        side: |c| moving_edge_side(c, edge_3d),
         near: |x| (19..41).contains(&x),
         // Measured 0.065 (feature-blind 0.104) and a ratio of 2.21.
         max_straddling: 0.09,
@@ -278,15 +267,7 @@ fn defocused_edge_4d() {
             lens: true,
         },
         field: defocus_4d,
-        side: |c| {
-            let (u0, u1) = (f64::from(c[2]) / 2.0, f64::from(c[2] + 1) / 2.0);
-            interval_side(
-                f64::from(c[0]),
-                f64::from(c[0] + 1),
-                edge_4d(u0),
-                edge_4d(u1),
-            )
-        },
+        side: |c| moving_edge_side(c, edge_4d),
         near: |x| (25..39).contains(&x),
         // Measured 0.074 (feature-blind 0.109) and a ratio of 2.81.
         max_straddling: 0.09,

@@ -40,13 +40,7 @@ fn exact(px: u32, py: u32) -> f64 {
 }
 
 fn space() -> RenderingSpace {
-    RenderingSpace {
-        x0: 0,
-        x1: W,
-        y0: 0,
-        y1: H,
-        dims: Dims::default(),
-    }
+    RenderingSpace::whole(W, H, Dims::default())
 }
 
 fn filter(name: &str) -> Box<dyn Filter> {

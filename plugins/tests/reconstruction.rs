@@ -51,16 +51,6 @@ fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dyn Sa
     (e.build)(&Choice::new(None, name, None), &setup).unwrap()
 }
 
-fn image_space(w: u32, h: u32, dims: Dims) -> RenderingSpace {
-    RenderingSpace {
-        x0: 0,
-        x1: w,
-        y0: 0,
-        y1: h,
-        dims,
-    }
-}
-
 /// Every point a sampler gives, batch by batch.
 fn batches(s: &mut dyn Sampler) -> Vec<Vec<SamplePoint>> {
     let mut out = Vec::new();
@@ -470,7 +460,12 @@ fn limit(reference: &Reference, f: Integrand, i: u32, j: u32) -> f64 {
 
 /// The image `sampler_name` and the filter `filter_name` make of `f` at `spp`.
 fn render(sampler_name: &str, f: &dyn Filter, g: Integrand, spp: u32, seed: u64) -> Vec<f64> {
-    let mut s = sampler(sampler_name, image_space(W, H, Dims::default()), spp, seed);
+    let mut s = sampler(
+        sampler_name,
+        RenderingSpace::whole(W, H, Dims::default()),
+        spp,
+        seed,
+    );
     assert_eq!(s.spp(), spp, "{sampler_name}");
     let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
     let mut b = Vec::new();
@@ -865,7 +860,7 @@ fn registry_samplers_stratify_the_rendering_space() {
         time: true,
         lens: true,
     };
-    let space = image_space(4, 4, all);
+    let space = RenderingSpace::whole(4, 4, all);
     let names: Vec<&str> = SAMPLERS.iter().map(|e| e.info.name).collect();
     for n in ["random", "stratified", "halton", "sobol"] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
@@ -928,7 +923,7 @@ fn registry_samplers_stratify_the_rendering_space() {
     }
     // Random: uniform by chi-square over many pixels, each projection and two pairs
     // (63 degrees of freedom: the 1e-6 tails lie near 25 and 120).
-    let pts: Vec<[f64; 5]> = pixels_of("random", image_space(32, 32, all), 16, 5)
+    let pts: Vec<[f64; 5]> = pixels_of("random", RenderingSpace::whole(32, 32, all), 16, 5)
         .concat()
         .iter()
         .map(coords)
@@ -965,7 +960,7 @@ fn random_sampler_points_are_independent() {
         lens: true,
     };
     let spp = 256;
-    let px = pixels_of("random", image_space(64, 64, all), spp, 7);
+    let px = pixels_of("random", RenderingSpace::whole(64, 64, all), spp, 7);
     let ratios: Vec<f64> = (0..5)
         .map(|d| {
             let v = px

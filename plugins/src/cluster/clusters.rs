@@ -292,17 +292,7 @@ mod tests {
     use crate::space::{Dims, RenderingSpace};
 
     fn grid(w: u32, h: u32) -> CellGrid {
-        CellGrid::new(
-            RenderingSpace {
-                x0: 0,
-                x1: w,
-                y0: 0,
-                y1: h,
-                dims: Dims::default(),
-            },
-            1.0,
-            2,
-        )
+        CellGrid::new(RenderingSpace::whole(w, h, Dims::default()), 1.0, 2)
     }
 
     #[test]

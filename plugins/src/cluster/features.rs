@@ -187,13 +187,7 @@ mod tests {
     use crate::space::{Dims, RenderingSpace};
 
     fn grid(w: u32, h: u32) -> CellGrid {
-        let sp = RenderingSpace {
-            x0: 0,
-            x1: w,
-            y0: 0,
-            y1: h,
-            dims: Dims::default(),
-        };
+        let sp = RenderingSpace::whole(w, h, Dims::default());
         CellGrid::new(sp, 1.0, 2)
     }
 

@@ -7,7 +7,7 @@
 //! them with the sampler's code and default knobs.
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
-use crate::cluster::build::{initial_clustering, ClusterParams, Initial};
+use crate::cluster::build::{initial_clustering, Initial};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
@@ -70,14 +70,11 @@ impl PolynomialFilter {
         let clustering = match (view.clustering, self.own) {
             (Some(c), None) => c,
             (_, own) => {
-                let d = ClusterSettings::new(1);
-                let (omega, max_cluster_cells) = own.unwrap_or((d.omega, d.max_cluster_cells));
-                let params = ClusterParams {
-                    omega,
-                    weights: d.weights,
-                    max_cluster_cells,
-                    log_features: d.log_features,
-                };
+                let mut params = ClusterSettings::new(1).cluster_params();
+                if let Some((omega, max_cells)) = own {
+                    params.omega = omega;
+                    params.max_cluster_cells = max_cells;
+                }
                 grown = Some(initial_clustering(grid, sums, &params));
                 &grown.as_ref().expect("just grown").clustering
             }
@@ -395,8 +392,14 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     let significance = float_in(p, "significance", 3.0, 0.0..=1e3)?;
     let mut f = PolynomialFilter::new(degree, ridge, clamp, significance);
     if p.get("omega").is_some() || p.get("maxclustercells").is_some() {
-        let omega = float_in(p, "omega", 0.7, 1e-3..=1e3)?;
-        let max_cells = int_in(p, "maxclustercells", 64, 1..=1 << 24)?;
+        let d = ClusterSettings::new(1);
+        let omega = float_in(p, "omega", d.omega, 1e-3..=1e3)?;
+        let max_cells = int_in(
+            p,
+            "maxclustercells",
+            d.max_cluster_cells as i32,
+            1..=1 << 24,
+        )?;
         f = f.with_own_clusters(omega, max_cells);
     }
     Ok(Box::new(f))

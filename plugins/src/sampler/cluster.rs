@@ -108,6 +108,16 @@ impl ClusterSettings {
             log_features: true,
         }
     }
+
+    /// The knobs of the clustering itself.
+    pub fn cluster_params(&self) -> ClusterParams {
+        ClusterParams {
+            omega: self.omega,
+            weights: self.weights,
+            max_cluster_cells: self.max_cluster_cells,
+            log_features: self.log_features,
+        }
+    }
 }
 
 /// A cell's new raw features and its feature vector before and after.
@@ -278,13 +288,7 @@ impl ClusterSampler {
 
     /// Ends the first stage: every cell's level and features, their scales, the clusters.
     fn cluster(&mut self) {
-        let params = ClusterParams {
-            omega: self.settings.omega,
-            weights: self.settings.weights,
-            max_cluster_cells: self.settings.max_cluster_cells,
-            log_features: self.settings.log_features,
-        };
-        let initial = initial_clustering(&self.grid, &self.sums, &params);
+        let initial = initial_clustering(&self.grid, &self.sums, &self.settings.cluster_params());
         self.feature_level = initial.levels.clone();
         self.levels = initial.levels;
         self.g = initial.g;
@@ -845,8 +849,13 @@ fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
     s.bins = int_in(p, "bins", s.bins as i32, 1..=16)?;
     let max = i64::from(spp);
     s.init_spp = int_in(p, "initspp", s.init_spp as i32, 1..=max)?;
-    s.min_spp = int_in(p, "minspp", 1, 0..=max)?;
-    s.max_cluster_cells = int_in(p, "maxclustercells", 64, 1..=1 << 24)?;
+    s.min_spp = int_in(p, "minspp", s.min_spp as i32, 0..=max)?;
+    s.max_cluster_cells = int_in(
+        p,
+        "maxclustercells",
+        s.max_cluster_cells as i32,
+        1..=1 << 24,
+    )?;
     for (k, name) in ["gradweight", "varweight", "posweight", "levelweight"]
         .iter()
         .enumerate()
