@@ -89,7 +89,7 @@ pub fn linearize(mut img: RgbImage) -> RgbImage {
 /// (v / 255 or v / 65535), HDR values stay as they are, grey becomes RGB.
 fn read_with_image_crate(path: &Path) -> Result<RgbImage, String> {
     let img = image::ImageReader::open(path)
-        .map_err(|e| e.to_string())?
+        .map_err(|e| acr_parser::io_message(&e))?
         .with_guessed_format()
         .map_err(|e| e.to_string())?
         .decode()
@@ -107,8 +107,25 @@ fn read_with_image_crate(path: &Path) -> Result<RgbImage, String> {
     })
 }
 
+/// Most pixels an image read from disk may have (16384 x 16384): a corrupt or hostile header
+/// fails here instead of sizing an allocation.
+pub const MAX_IMAGE_PIXELS: usize = 1 << 28;
+
 fn read_exr(path: &Path) -> Result<RgbImage, String> {
     use exr::prelude::*;
+    // The header first: its sizes must be sane before the pixels are allocated.
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| match e {
+        exr::error::Error::Io(io) => acr_parser::io_message(&io),
+        other => other.to_string(),
+    })?;
+    for h in meta.headers.iter() {
+        let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+        if w.checked_mul(ht).is_none_or(|n| n > MAX_IMAGE_PIXELS) {
+            return Err(format!(
+                "the image is {w}x{ht}, more than {MAX_IMAGE_PIXELS} pixels"
+            ));
+        }
+    }
     let rgba = read_first_rgba_layer_from_file(
         path,
         |size: Vec2<usize>, _: &RgbaChannels| RgbImage::new(size.width(), size.height()),
@@ -147,7 +164,7 @@ fn read_exr(path: &Path) -> Result<RgbImage, String> {
 /// Reads a PFM file: `PF` (RGB) or `Pf` (grey), width, height and a scale whose sign gives the
 /// byte order (negative: little-endian), then rows of 32-bit floats from the bottom up.
 fn read_pfm(path: &Path) -> Result<RgbImage, String> {
-    let data = std::fs::read(path).map_err(|e| e.to_string())?;
+    let data = acr_parser::source::read_file(path).map_err(|e| acr_parser::io_message(&e))?;
     parse_pfm(&data)
 }
 
@@ -190,8 +207,10 @@ fn parse_pfm(data: &[u8]) -> Result<RgbImage, String> {
     let n = width
         .checked_mul(height)
         .and_then(|v| v.checked_mul(channels))
+        .filter(|&n| n <= 3 * MAX_IMAGE_PIXELS)
         .ok_or("PFM too large")?;
     let raster = data.get(pos..).unwrap_or(&[]);
+    // n <= 3 * 2^28, so 4 * n cannot overflow.
     if raster.len() < 4 * n {
         return Err(format!(
             "truncated PFM raster: {} bytes for {width}x{height}x{channels} floats",

@@ -2,8 +2,9 @@
 //! added to the film in a fixed order, so the image depends on the scene, seed and budget only.
 
 use crate::camera::CameraSample;
+use crate::geometry::Ray;
 use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
-use crate::integrator::Integrator;
+use crate::integrator::{Integrator, Radiance};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
 use acr_plugins::sampler::SOBOL_DIMS_USED;
@@ -61,6 +62,25 @@ pub fn render(
     time_limit: Option<Duration>,
     progress: Option<&indicatif::ProgressBar>,
 ) -> RenderCounts {
+    let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
+    render_with(scene, &li, sampler, film, seed, time_limit, progress)
+}
+
+/// What a sample estimates: the radiance arriving along a camera ray.
+pub type Estimator<'a> = dyn Fn(&Scene, Ray, &mut SampleStream) -> Radiance + Sync + 'a;
+
+/// [`render`] with any estimator in place of an integrator (tests give it one that misbehaves).
+/// Radiance that is NaN, infinite or negative is dropped and counted where it arises; the rest
+/// is clamped by the film's limits before the sampler, the cells and the film see it.
+pub fn render_with(
+    scene: &Scene,
+    li: &Estimator<'_>,
+    sampler: &mut dyn Sampler,
+    film: &mut Film,
+    seed: u64,
+    time_limit: Option<Duration>,
+    progress: Option<&indicatif::ProgressBar>,
+) -> RenderCounts {
     let start = Instant::now();
     let full_width = u64::from(scene.film.resolution.0);
     let space = rendering_space(scene);
@@ -74,6 +94,7 @@ pub fn render(
     let mut radiance: Vec<[f32; 3]> = Vec::new();
     let mut valid: Vec<(Vec2, Spectrum)> = Vec::new();
     let mut in_sampler = Duration::ZERO;
+    let limits = film.settings().clone();
     loop {
         let t = Instant::now();
         let more = sampler.next_batch(&mut batch);
@@ -92,7 +113,7 @@ pub fn render(
                     lens: Vec2::from(q.lens),
                     time: q.time,
                 });
-                let r = integrator.li(scene, ray, &mut stream);
+                let r = li(scene, ray, &mut stream);
                 (r.l, r.rays)
             })
             .collect_into_vec(&mut results);
@@ -101,6 +122,7 @@ pub fn render(
         for (q, &(l, rays)) in batch.iter().zip(&results) {
             counts.rays += u64::from(rays);
             if is_valid_radiance(l) {
+                let l = limits.clamp(l);
                 valid.push((Vec2::from(q.film), l));
                 radiance.push(l.to_array());
             } else {

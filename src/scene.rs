@@ -146,6 +146,64 @@ impl Builder<'_> {
         }
     }
 
+    /// Whether a shape's size is positive and finite; if not, warns that the shape is skipped
+    /// (a zero or negative radius makes a shape with no area, which no ray can hit and no
+    /// light can sample without dividing by zero).
+    fn positive_size(&mut self, p: &PluginDesc, what: &str, v: f32) -> bool {
+        if v > 0.0 && v.is_finite() {
+            return true;
+        }
+        let loc = p.params.get(what).map_or(&p.loc, |x| &x.loc);
+        self.warnings.push(Warning::at(
+            loc,
+            format!(
+                "{}: {what} is {v}; the shape has no area and is skipped",
+                p.kind
+            ),
+        ));
+        false
+    }
+
+    /// Adds a triangle mesh and a primitive for each of its triangles with a positive, finite
+    /// world-space area; warns once per shape about the others, which are skipped (they could
+    /// never be hit, and as emitters their area would divide by zero).
+    fn add_triangles(
+        &mut self,
+        geom: &mut Geometry,
+        tm: TriangleMesh,
+        prims: &mut Vec<PrimKind>,
+        loc: &acr_parser::Loc,
+        kind: &str,
+    ) {
+        let mesh_index = geom.meshes.len() as u32;
+        let n = tm.triangle_count();
+        let before = prims.len();
+        prims.extend(
+            (0..n)
+                .filter(|&tri| {
+                    // The intersection test's own zero-area test, and finite vertices.
+                    let [a, b, c] = tm.vertices(tri);
+                    let n = (a - c).cross(b - c);
+                    n != Vec3::ZERO && n.is_finite()
+                })
+                .map(|tri| PrimKind::Triangle {
+                    mesh: mesh_index,
+                    tri: tri as u32,
+                }),
+        );
+        let skipped = n - (prims.len() - before);
+        if skipped > 0 {
+            self.warnings.push(Warning::at(
+                loc,
+                format!(
+                    "{kind}: {skipped} of {n} triangles are degenerate (zero area or \
+                     non-finite vertices) and are skipped"
+                ),
+            ));
+        }
+        geom.meshes.push(tm);
+    }
+
     fn surface(&mut self, s: Surface) -> u32 {
         self.surfaces.push(s);
         (self.surfaces.len() - 1) as u32
@@ -181,13 +239,7 @@ impl Builder<'_> {
                     return Ok(());
                 };
                 let tm = TriangleMesh::from_mesh(mesh, &to_world, shape.reverse_orientation);
-                let mesh_index = geom.meshes.len() as u32;
-                let n = tm.indices.len() / 3;
-                geom.meshes.push(tm);
-                prims.extend((0..n as u32).map(|tri| PrimKind::Triangle {
-                    mesh: mesh_index,
-                    tri,
-                }));
+                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
                 // Parameters pbrt-v3 reads for meshes that acr has no use for.
                 for unused in ["alpha", "shadowalpha", "S", "faceIndices"] {
                     if let Some(x) = params.get(unused) {
@@ -203,16 +255,13 @@ impl Builder<'_> {
                 let mesh =
                     crate::shapes::loopsubdiv::mesh_from_params(params, &p.loc, self.warnings)?;
                 let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
-                let mesh_index = geom.meshes.len() as u32;
-                let n = tm.indices.len() / 3;
-                geom.meshes.push(tm);
-                prims.extend((0..n as u32).map(|tri| PrimKind::Triangle {
-                    mesh: mesh_index,
-                    tri,
-                }));
+                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
             }
             "sphere" => {
                 let r = params.float_or("radius", 1.0)? as f32;
+                if !self.positive_size(p, "radius", r) {
+                    return Ok(());
+                }
                 let s = Sphere::new(
                     r,
                     params.float_or("zmin", -r as f64)? as f32,
@@ -225,10 +274,19 @@ impl Builder<'_> {
                 geom.spheres.push(s);
             }
             "disk" => {
-                let d = Disk::new(
-                    params.float_or("height", 0.0)? as f32,
+                let (r, ri) = (
                     params.float_or("radius", 1.0)? as f32,
                     params.float_or("innerradius", 0.0)? as f32,
+                );
+                if !self.positive_size(p, "radius", r)
+                    || !self.positive_size(p, "radius - innerradius", r - ri.max(0.0))
+                {
+                    return Ok(());
+                }
+                let d = Disk::new(
+                    params.float_or("height", 0.0)? as f32,
+                    r,
+                    ri.max(0.0),
                     params.float_or("phimax", 360.0)? as f32,
                     to_world,
                     shape.reverse_orientation,
@@ -237,10 +295,20 @@ impl Builder<'_> {
                 geom.disks.push(d);
             }
             "cylinder" => {
-                let c = Cylinder::new(
-                    params.float_or("radius", 1.0)? as f32,
+                let r = params.float_or("radius", 1.0)? as f32;
+                let (z0, z1) = (
                     params.float_or("zmin", -1.0)? as f32,
                     params.float_or("zmax", 1.0)? as f32,
+                );
+                if !self.positive_size(p, "radius", r)
+                    || !self.positive_size(p, "|zmax - zmin|", (z1 - z0).abs())
+                {
+                    return Ok(());
+                }
+                let c = Cylinder::new(
+                    r,
+                    z0,
+                    z1,
                     params.float_or("phimax", 360.0)? as f32,
                     to_world,
                     shape.reverse_orientation,

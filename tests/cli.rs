@@ -505,6 +505,47 @@ fn scene_errors_are_located_and_never_panic() {
     }
 }
 
+/// Every file in tests/data/bad (parse errors) and tests/data/bad-render (scenes that parse
+/// but cannot be built: absurd sizes, missing or hostile files, bad values), and each of their
+/// PLY and image files given as a scene: `acr render` exits with status 1 within seconds,
+/// prints `FILE:LINE:COL: message` first (the empty file has no place to point to: `FILE:
+/// message`), never panics and writes no image. A folder and a missing file fail the same way.
+#[test]
+fn every_bad_input_fails_cleanly_with_its_location() {
+    let dir = TempDir::new("bad-inputs");
+    let out = dir.join("out.png");
+    let mut files: Vec<PathBuf> = ["tests/data/bad", "tests/data/bad-render"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root().join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(files.len() >= 40, "{} files", files.len());
+    let unlocated = |p: &Path| p.file_name().is_some_and(|n| n == "empty.pbrt");
+    let mut extra = vec![root().join("tests/data"), dir.join("no-such-scene.pbrt")];
+    files.append(&mut extra);
+    for f in &files {
+        let o = output_within(acr_command(render_args(f, &out)), Duration::from_secs(60));
+        let what = f.display().to_string();
+        assert_clean_failure(&o, &what);
+        assert_eq!(o.status.code(), Some(1), "{what}");
+        let err = stderr(&o);
+        let first = err.lines().next().unwrap_or("");
+        let rest = first
+            .strip_prefix(&format!("{}:", f.display()))
+            .unwrap_or_else(|| panic!("{what}: not prefixed by the file: {first}"));
+        let mut fields = rest.splitn(3, ':');
+        let located = matches!(
+            (fields.next(), fields.next(), fields.next()),
+            (Some(l), Some(c), Some(m)) if l.parse::<u32>().is_ok()
+                && c.parse::<u32>().is_ok() && m.starts_with(' ')
+        );
+        let expect_location = f.is_file() && !unlocated(f);
+        assert_eq!(located, expect_location, "{what}: {first}");
+        assert!(!out.exists(), "{what}: an image was written");
+    }
+}
+
 /// The number after `name ` in `acr diff`'s text output.
 fn text_field(text: &str, name: &str) -> f64 {
     let mut words = text.split_whitespace();

@@ -79,20 +79,24 @@ fn parse_source(file: Arc<SourceFile>) -> Result<SceneDescription> {
 
 /// Reads a scene file, mapping I/O and encoding errors to a clear message.
 fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::file(path, io_message(&e)))?;
+    let bytes = crate::source::read_file(path).map_err(|e| Error::file(path, io_message(&e)))?;
+    decode_text(path, bytes)
+}
+
+/// The text of a scene file's bytes; invalid UTF-8 is an error at its line and column.
+fn decode_text(path: &Path, bytes: Vec<u8>) -> Result<String> {
     String::from_utf8(bytes).map_err(|e| {
-        Error::file(
-            path,
-            format!(
-                "not a text file: invalid UTF-8 at byte {}",
-                e.utf8_error().valid_up_to()
-            ),
-        )
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.into_bytes();
+        let byte = bytes.get(at).copied().unwrap_or(0);
+        let message = format!("not a text file: byte 0x{byte:02x} at offset {at} is not UTF-8");
+        let file = SourceFile::new(path, String::from_utf8_lossy(&bytes).into_owned());
+        Error::at(&Loc::new(&file, at), message)
     })
 }
 
 /// An I/O error in words, without Rust's "(os error 2)" suffix.
-pub(crate) fn io_message(e: &std::io::Error) -> String {
+pub fn io_message(e: &std::io::Error) -> String {
     match e.kind() {
         std::io::ErrorKind::NotFound => "no such file".to_owned(),
         std::io::ErrorKind::PermissionDenied => "permission denied".to_owned(),
@@ -381,14 +385,13 @@ impl Parser {
             ));
         }
         let path = resolve_path(name, self.file(), &self.base_dir);
-        let text = std::fs::read(&path).map_err(|e| {
+        let bytes = crate::source::read_file(&path).map_err(|e| {
             Error::at(
                 loc,
                 format!("cannot read included file \"{name}\": {}", io_message(&e)),
             )
         })?;
-        let text = String::from_utf8(text)
-            .map_err(|_| Error::at(loc, format!("included file \"{name}\" is not UTF-8 text")))?;
+        let text = decode_text(&path, bytes)?;
         let file = SourceFile::new(path, text);
         self.builder.add_file(Arc::clone(&file));
         self.stack.push(Tokenizer::new(file));

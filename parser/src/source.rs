@@ -85,7 +85,13 @@ impl Loc {
         let line = line.trim_end_matches('\r');
         let chars: Vec<char> = line
             .chars()
-            .map(|c| if c == '\t' { ' ' } else { c })
+            // Tabs as spaces keep the caret aligned; other control characters (from a binary
+            // file given as a scene) would move the terminal's cursor or ring its bell.
+            .map(|c| match c {
+                '\t' => ' ',
+                c if c.is_control() => '?',
+                c => c,
+            })
             .collect();
         let col = String::from_utf8_lossy(&bytes[start..offset])
             .chars()
@@ -114,4 +120,21 @@ impl fmt::Debug for Loc {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         fmt::Display::fmt(self, f)
     }
+}
+
+/// Reads a whole file named in a scene, refusing devices and sockets (`/dev/zero` would never
+/// end) with an `InvalidInput` error before reading anything.
+pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = std::fs::metadata(path)?.file_type();
+        if t.is_char_device() || t.is_block_device() || t.is_socket() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file but a device or socket",
+            ));
+        }
+    }
+    std::fs::read(path)
 }

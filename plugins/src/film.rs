@@ -24,6 +24,10 @@ const TABLE_SIZE: usize = 16;
 /// Largest accepted resolution per axis: keeps a typo from allocating terabytes.
 pub const MAX_RESOLUTION: u32 = 1 << 15;
 
+/// Largest accepted number of rendered (cropped) pixels, 8192 x 8192: the film keeps about
+/// 100 bytes per pixel, so this bounds it near 7 GiB before anything is allocated.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
 /// Film settings from the `Film` directive.
 #[derive(Clone, Debug)]
 pub struct FilmSettings {
@@ -38,6 +42,9 @@ pub struct FilmSettings {
     /// Samples whose luminance exceeds this are scaled down to it (pbrt-v3's
     /// maxsampleluminance); infinite by default.
     pub max_sample_luminance: f32,
+    /// Samples whose largest RGB component exceeds this are scaled down to it (pbrt-v4's
+    /// maxcomponentvalue); infinite by default.
+    pub max_component_value: f32,
 }
 
 impl FilmSettings {
@@ -85,7 +92,28 @@ impl FilmSettings {
         }
         s.filename = params.string("filename")?.map(str::to_owned);
         s.scale = params.float_or("scale", 1.0)? as f32;
-        s.max_sample_luminance = params.float_or("maxsampleluminance", f64::INFINITY)? as f32;
+        let positive = |name: &str| -> Result<f32> {
+            let v = params.float_or(name, f64::INFINITY)?;
+            if v.is_nan() || v <= 0.0 {
+                let loc = params.get(name).map_or(&p.loc, |x| &x.loc);
+                return Err(Error::at(loc, format!("{name} must be positive, not {v}")));
+            }
+            Ok(v as f32)
+        };
+        s.max_sample_luminance = positive("maxsampleluminance")?;
+        s.max_component_value = positive("maxcomponentvalue")?;
+        let (w, h) = s.size();
+        if u64::from(w) * u64::from(h) > MAX_PIXELS {
+            let loc = params.get("xresolution").map_or(&p.loc, |x| &x.loc);
+            return Err(Error::at(
+                loc,
+                format!(
+                    "{w}x{h} = {} pixels to render is more than {MAX_PIXELS} (8192x8192); \
+                     lower the resolution or set a cropwindow",
+                    u64::from(w) * u64::from(h)
+                ),
+            ));
+        }
         // Accepted, and meaningless for an RGB film.
         let _ = params.float("diagonal")?;
         Ok(s)
@@ -99,6 +127,25 @@ impl FilmSettings {
             filename: None,
             scale: 1.0,
             max_sample_luminance: f32::INFINITY,
+            max_component_value: f32::INFINITY,
+        }
+    }
+
+    /// A sample's radiance after the film's limits: scaled down so that its luminance is at
+    /// most `maxsampleluminance` and its largest component at most `maxcomponentvalue`.
+    #[inline]
+    pub fn clamp(&self, l: Spectrum) -> Spectrum {
+        let lum = luminance(l);
+        let l = if lum > self.max_sample_luminance {
+            l * (self.max_sample_luminance / lum)
+        } else {
+            l
+        };
+        let m = l.max_element();
+        if m > self.max_component_value {
+            l * (self.max_component_value / m)
+        } else {
+            l
         }
     }
 
@@ -202,7 +249,7 @@ struct Splat {
     table: [f32; TABLE_SIZE * TABLE_SIZE],
     radius: (f32, f32),
     columns: (i64, i64),
-    max_luminance: f32,
+    limits: FilmSettings,
 }
 
 impl Splat {
@@ -288,15 +335,10 @@ impl Splat {
         }
     }
 
-    /// The radiance after the film's luminance clamp (pbrt-v3's maxsampleluminance).
+    /// The radiance after the film's limits ([`FilmSettings::clamp`]).
     #[inline]
     fn clamped(&self, l: Spectrum) -> Spectrum {
-        let lum = luminance(l);
-        if lum > self.max_luminance {
-            l * (self.max_luminance / lum)
-        } else {
-            l
-        }
+        self.limits.clamp(l)
     }
 }
 
@@ -351,7 +393,7 @@ impl Film {
                 table,
                 radius: (rx, ry),
                 columns: (cx0 as i64, cx1 as i64),
-                max_luminance: settings.max_sample_luminance,
+                limits: settings.clone(),
             },
             settings,
             prepared: Vec::new(),

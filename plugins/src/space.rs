@@ -85,8 +85,9 @@ impl RenderingSpace {
 pub struct SamplePoint {
     /// The pixel the point was drawn for, `[x, y]`.
     pub pixel: [u32; 2],
-    /// The sample's index within its pixel (0..spp): with `pixel` and the seed it keys the
-    /// integrator's per-sample random stream.
+    /// The sample's index within its pixel (0, 1, 2, ... in the order drawn; below spp except
+    /// for adaptive samplers, which give some pixels more): with `pixel` and the seed it keys
+    /// the integrator's per-sample random stream.
     pub index: u32,
     /// Raster position, inside `[pixel, pixel + 1)` in both axes.
     pub film: [f32; 2],

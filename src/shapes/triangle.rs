@@ -753,6 +753,65 @@ mod tests {
         assert_watertight(&subdivided_cube(4, 4096.0, c), c, 4096.0, 1e5);
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2048))]
+
+        /// Property: a closed mesh placed anywhere (rotated, scaled from 1e-3 to 1e4, up to
+        /// 1e6 from the origin, at least 1e-4 of its distance across) has no cracks: a ray from outside, aimed through a vertex or a
+        /// point of a shared edge at a point inside, hits a front face, and the ray from the
+        /// inside point back out through it hits a back face.
+        #[test]
+        fn closed_meshes_anywhere_have_no_cracks_at_shared_edges_and_vertices(
+            cube in proptest::prelude::any::<bool>(),
+            n in 1usize..4,
+            axis in proptest::array::uniform3(-1.0f32..1.0),
+            angle in 0.0f32..360.0,
+            log_scale in -3.0f32..4.0,
+            centre in proptest::array::uniform3(-1e6f32..1e6),
+            tri_pick in 0usize..10_000,
+            edge in 0usize..3,
+            k in 0u32..4,
+            inner_offset in proptest::array::uniform3(-1.0f32..1.0),
+            log_far in 0.0f32..5.0,
+        ) {
+            let centre = Vec3::from_array(centre);
+            // At least ~1600 ulps of the centre's coordinates across: smaller meshes collapse
+            // in f32 (the ulp at 1e6 is 0.0625) and are no longer the same solid.
+            let scale = 10f32.powf(log_scale).max(1e-4 * centre.abs().max_element());
+            let axis = Vec3::from_array(axis).try_normalize().unwrap_or(Vec3::Z);
+            let m = Mat4::from_translation(centre)
+                * Mat4::from_axis_angle(axis, angle.to_radians())
+                * Mat4::from_scale(Vec3::splat(scale));
+            let mut mesh = if cube {
+                subdivided_cube(n, 1.0, Vec3::ZERO)
+            } else {
+                octahedron(1.0, Vec3::ZERO)
+            };
+            for p in &mut mesh.positions {
+                *p = m.transform_point3(*p);
+            }
+            let v = mesh.vertices(tri_pick % mesh.triangle_count());
+            let (a, b) = (v[edge], v[(edge + 1) % 3]);
+            let q = a + (b - a) * (k as f32 * 0.25);
+            // Well inside both solids (the octahedron's inscribed sphere has radius 0.577).
+            let inner = centre + Vec3::from_array(inner_offset) * (0.3 * scale);
+            let dir = (q - inner).normalize();
+            let far = scale * 10f32.powf(log_far);
+            let from_outside = Ray::new(q + dir * far, -dir, 0.0);
+            let hit = closest(&mesh, &from_outside, f32::INFINITY);
+            proptest::prop_assert!(hit.is_some(), "crack: ray from outside through {} missed", q);
+            let (tri, h) = hit.unwrap();
+            let si = triangle_interaction(&mesh, tri, &from_outside, &h);
+            proptest::prop_assert!(si.n.dot(from_outside.d) < 0.0, "back face from outside");
+            let from_inside = Ray::new(inner, q - inner, 0.0);
+            let hit = closest(&mesh, &from_inside, f32::INFINITY);
+            proptest::prop_assert!(hit.is_some(), "crack: ray from inside through {} missed", q);
+            let (tri, h) = hit.unwrap();
+            let si = triangle_interaction(&mesh, tri, &from_inside, &h);
+            proptest::prop_assert!(si.n.dot(from_inside.d) > 0.0, "front face from inside");
+        }
+    }
+
     #[test]
     fn axis_aligned_rays_at_shared_edges_hit() {
         // Rays exactly along the axes at the cube's grid lines (edge functions exactly 0).
