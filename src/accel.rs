@@ -111,7 +111,12 @@ impl Geometry {
 
     /// Bounds of one primitive.
     fn prim_bounds(&self, p: &Prim) -> (Vec3, Vec3) {
-        match p.kind {
+        self.kind_bounds(p.kind)
+    }
+
+    /// Bounds of the primitive `kind` (its shape must be in this geometry).
+    pub fn kind_bounds(&self, kind: PrimKind) -> (Vec3, Vec3) {
+        match kind {
             PrimKind::Triangle { mesh, tri } => {
                 triangle_bounds(&self.meshes[mesh as usize], tri as usize)
             }
@@ -322,6 +327,11 @@ pub struct Instance {
 }
 
 /// The scene's acceleration structure.
+/// Whether `[lo, hi]` is a box the BVH builder can take: finite corners, `lo <= hi`.
+pub fn finite_box(lo: Vec3, hi: Vec3) -> bool {
+    lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()
+}
+
 #[derive(Default)]
 pub struct Accel {
     /// Static shapes in world space.
@@ -335,17 +345,28 @@ pub struct Accel {
 }
 
 impl Accel {
-    /// Builds every BVH. Call once after adding everything.
-    pub fn build(&mut self) {
+    /// Builds every BVH. Call once after adding everything. Gives the number of instances
+    /// dropped because their placement takes them beyond f32's range (the BVH builder needs
+    /// finite boxes).
+    pub fn build(&mut self) -> usize {
         self.world.build();
         for g in &mut self.objects {
             g.build();
         }
         self.instances
             .retain(|i| !self.objects[i.object as usize].is_empty());
+        let before = self.instances.len();
+        let objects = &self.objects;
+        self.instances.retain(|i| {
+            let (lo, hi) = i
+                .placement
+                .world_bounds(objects[i.object as usize].bounds());
+            finite_box(lo, hi)
+        });
+        let dropped = before - self.instances.len();
         if self.instances.is_empty() {
             self.tlas = None;
-            return;
+            return dropped;
         }
         let aabbs: Vec<Aabb> = self
             .instances
@@ -363,6 +384,7 @@ impl Accel {
         );
         self.tlas_order = bvh.primitive_indices.clone();
         self.tlas = Some(bvh);
+        dropped
     }
 
     /// True when anything in the scene moves (there is a moving instance).

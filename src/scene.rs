@@ -325,6 +325,22 @@ impl Builder<'_> {
                 return Ok(());
             }
         }
+        // Coordinates beyond f32's range (or NaN) relative to the camera: no box holds them.
+        let before = prims.len();
+        prims.retain(|&k| {
+            let (lo, hi) = geom.kind_bounds(k);
+            crate::accel::finite_box(lo, hi)
+        });
+        if prims.len() < before {
+            self.warnings.push(Warning::at(
+                &p.loc,
+                format!(
+                    "{kind}: {} of {before} primitives lie beyond the range of 32-bit floats \
+                     seen from the camera, or have NaN coordinates, and are skipped",
+                    before - prims.len()
+                ),
+            ));
+        }
         if area_light.is_none() {
             let surface = self.surface(Surface {
                 material,
@@ -456,18 +472,28 @@ impl Builder<'_> {
 }
 
 /// The translation that takes the camera's position (at its start transform) to the origin.
-/// Exact in f64; a camera description that cannot be inverted gives the identity.
-fn render_from_world(camera: &acr_parser::CameraDesc) -> DMat4 {
+/// Exact in f64; a camera description that cannot be inverted gives the identity. A camera
+/// beyond the range of 32-bit floats is an error: nothing could be placed relative to it.
+fn render_from_world(camera: &acr_parser::CameraDesc) -> Result<DMat4> {
     let camera_pos = camera
         .camera_from_world
         .start
         .inverse()
         .transform_point3(glam::DVec3::ZERO);
-    if camera_pos.is_finite() {
-        DMat4::from_translation(-camera_pos)
-    } else {
-        DMat4::IDENTITY
+    if !camera_pos.is_finite() {
+        return Ok(DMat4::IDENTITY);
     }
+    if camera_pos.abs().max_element() > f64::from(f32::MAX) {
+        return Err(Error::at(
+            &camera.plugin.loc,
+            format!(
+                "the camera stands at ({:.3e}, {:.3e}, {:.3e}), beyond the range of 32-bit \
+                 floats (3.4e38); move the scene nearer the origin",
+                camera_pos.x, camera_pos.y, camera_pos.z
+            ),
+        ));
+    }
+    Ok(DMat4::from_translation(-camera_pos))
 }
 
 /// An RGB-valued parameter (rgb, spectrum or blackbody) or its default.
@@ -506,7 +532,7 @@ impl Scene {
             return Err(Error::file(path, "the scene has no Camera"));
         };
         let film = FilmSettings::new(desc.film.as_ref())?;
-        let render_from_world = render_from_world(camera_desc);
+        let render_from_world = render_from_world(camera_desc)?;
         let in_render = |t: &acr_parser::AnimatedTransform| acr_parser::AnimatedTransform {
             start: render_from_world * t.start,
             end: render_from_world * t.end,
@@ -583,7 +609,16 @@ impl Scene {
             });
         }
         accel.world = world;
-        accel.build();
+        let dropped = accel.build();
+        if dropped > 0 {
+            b.warnings.push(Warning {
+                loc: None,
+                message: format!(
+                    "{dropped} object instances are placed beyond the range of 32-bit floats \
+                     and are skipped"
+                ),
+            });
+        }
         let (lo, hi) = accel.bounds();
         let (world_center, world_radius) = if lo.cmple(hi).all() {
             ((lo + hi) * 0.5, (hi - lo).length() * 0.5)

@@ -82,7 +82,8 @@ fn degenerate_shapes_are_skipped_with_a_warning_and_render_cleanly() {
         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n\
         Shape \"sphere\" \"float radius\" 0\n\
         Shape \"trianglemesh\" \"integer indices\" [0 1 2  0 1 3  2 2 2]\n\
-        \"point3 P\" [-1 3 -1  1 3 -1  3 3 -1  -1 3 1]\nAttributeEnd\n";
+        \"point3 P\" [-1 3 -1  1 3 -1  3 3 -1  -1 3 1]\nAttributeEnd\n\
+        AttributeBegin\nScale 1e30 1e30 1e30\nShape \"sphere\" \"float radius\" 1e10\nAttributeEnd\n";
     let text = dim_scene("", world);
     let (_, _, warnings) = build(&text, &Overrides::default(), 4);
     let text_of: Vec<String> = warnings.iter().map(|w| w.to_string()).collect();
