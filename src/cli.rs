@@ -272,7 +272,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         threads: rayon::current_num_threads(),
         seed: args.seed,
         sampler: plugins.sampler.name().into(),
-        filter: plugins.filter.name().into(),
+        filter: plugins.reconstruction().into(),
         integrator: plugins.integrator.name().into(),
         halted: counts.halted,
         dims: scene.dims.names().into_iter().map(str::to_owned).collect(),

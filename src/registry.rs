@@ -45,6 +45,16 @@ pub struct Plugins {
 }
 
 impl Plugins {
+    /// The name of what makes the image: the sampler's, when it reconstructs itself (mdas,
+    /// gem, awr), else the filter's.
+    pub fn reconstruction(&self) -> &'static str {
+        if self.sampler.reconstructs() {
+            self.sampler.name()
+        } else {
+            self.filter.name()
+        }
+    }
+
     /// An empty film for `scene`, splatting with the filter's kernel, and collecting the cells
     /// the filter needs when the sampler keeps none.
     pub fn film(&self, scene: &crate::scene::Scene) -> Film {
@@ -62,14 +72,17 @@ impl Plugins {
     /// has one, times the film's `scale`; row-major over the cropped film.
     pub fn image(&self, film: &Film) -> Vec<Spectrum> {
         let scale = film.settings().scale;
-        self.filter
-            .reconstruct(
-                film,
-                SamplerOutput {
-                    partition: self.sampler.partition(),
-                    cells: self.sampler.cells(),
-                },
-            )
+        self.sampler
+            .reconstruct(film)
+            .unwrap_or_else(|| {
+                self.filter.reconstruct(
+                    film,
+                    SamplerOutput {
+                        partition: self.sampler.partition(),
+                        cells: self.sampler.cells(),
+                    },
+                )
+            })
             .into_iter()
             .map(|c| c * scale)
             .collect()
@@ -121,6 +134,24 @@ pub fn choose(
     );
     let se: &Entry<SamplerBuild> = resolve(SAMPLERS, Kind::Sampler, &mut sc, overrides, warnings)?;
     let sampler = (se.build)(&sc, &setup())?;
+    if sampler.reconstructs() {
+        // The method's reconstruction is part of it: a filter asked for is not used.
+        let named = overrides
+            .filter
+            .as_deref()
+            .map(|f| (f.to_owned(), None))
+            .or_else(|| desc.filter.as_ref().map(|f| (f.kind.clone(), Some(&f.loc))));
+        if let Some((name, loc)) = named {
+            let message = format!(
+                "the {} sampler reconstructs the image itself; filter \"{name}\" is not used",
+                sampler.name()
+            );
+            warnings.push(match loc {
+                Some(loc) => Warning::at(loc, message),
+                None => Warning { loc: None, message },
+            });
+        }
+    }
     // `check_params` has warned of what the plugins do not declare, on its copies; the
     // directives' own parameters need no second, vaguer warning.
     for d in [&desc.sampler, &desc.filter, &desc.integrator]

@@ -104,7 +104,8 @@ proptest! {
         }
         let total: u64 = count.iter().map(|&c| u64::from(c)).sum();
         prop_assert_eq!(total, space.pixels() * u64::from(spp), "{}: budget", name);
-        if !name.starts_with("cluster") {
+        // The adaptive samplers (those that report rounds) give pixels unequal shares.
+        if s.report().rounds.is_none() {
             prop_assert!(count.iter().all(|&c| c == spp), "{}: uneven {:?}", name, count);
         }
     }

@@ -2,19 +2,25 @@
 //! row-major order. Every sampler is deterministic in (space, spp, seed) and keeps no global
 //! state, so an image does not depend on the thread count. A new sampler is one file here.
 
+mod awr;
 mod cluster;
+mod gem;
 mod halton;
+mod mdas;
+mod pixel_rounds;
 mod random;
 mod sobol;
 mod stratified;
 
 pub use cluster::{ClusterSampler, ClusterSettings, Priority};
 pub use halton::HaltonSampler;
+pub use pixel_rounds::PixelMoments;
 pub use random::RandomSampler;
 pub use sobol::{SobolSampler, SOBOL_DIMS_USED, SOBOL_SAMPLES};
 pub use stratified::StratifiedSampler;
 
 use crate::cluster::CellView;
+use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
 use crate::registry::{Choice, Entry};
 pub(crate) use crate::rng::{mix64, Pcg32};
@@ -69,6 +75,21 @@ pub trait Sampler: Send {
     fn report(&self) -> SamplerReport {
         SamplerReport::default()
     }
+
+    /// Whether the sampler makes the image itself ([`Sampler::reconstruct`]), as the methods
+    /// whose reconstruction is part of them do (mdas, gem, awr); the filter is then unused.
+    fn reconstructs(&self) -> bool {
+        false
+    }
+
+    /// The image, row-major over the space's pixels, when the sampler [reconstructs]
+    /// (`film` holds the splats and per-pixel statistics of every sample).
+    ///
+    /// [reconstructs]: Sampler::reconstructs
+    fn reconstruct(&self, film: &Film) -> Option<Vec<Spectrum>> {
+        let _ = film;
+        None
+    }
 }
 
 /// An adaptive sampler's figures for the stats file.
@@ -103,6 +124,9 @@ pub static SAMPLERS: &[Entry<SamplerBuild>] = &[
     halton::ENTRY,
     sobol::ENTRY,
     cluster::ENTRY,
+    mdas::ENTRY,
+    gem::ENTRY,
+    awr::ENTRY,
 ];
 
 /// The `pixelsamples` parameter, or the command line's `--spp`, checked to lie in 1..=MAX_SPP.

@@ -1,0 +1,285 @@
+//! What the image-space adaptive samplers (`gem`, `awr`) share: rounds of samples allocated to
+//! pixels from per-pixel statistics, each sample uniform in its pixel and the active dims.
+//! A method supplies the per-pixel error that steers the next round and the reconstruction.
+
+// Channel and dim loops index several small arrays at once, as the formulas do.
+#![allow(clippy::needless_range_loop)]
+
+use super::{pixel_key, Pcg32, Sampler, BATCH_SAMPLES};
+use crate::film::{luminance, Film, Spectrum};
+use crate::space::{in_pixel, RenderingSpace, SamplePoint};
+
+/// Per-pixel running statistics of the samples a sampler has seen (dropped ones excluded).
+#[derive(Clone, Debug, Default)]
+pub struct PixelMoments {
+    /// Samples per pixel, row-major over the space.
+    pub count: Vec<u32>,
+    /// Sum of radiance per pixel.
+    pub sum: Vec<[f64; 3]>,
+    /// Sum of squared luminance per pixel.
+    pub sum_sq: Vec<f64>,
+}
+
+impl PixelMoments {
+    fn new(pixels: usize) -> Self {
+        Self {
+            count: vec![0; pixels],
+            sum: vec![[0.0; 3]; pixels],
+            sum_sq: vec![0.0; pixels],
+        }
+    }
+
+    /// Mean radiance of pixel `i` (0 without samples).
+    pub fn mean(&self, i: usize) -> [f64; 3] {
+        let n = f64::from(self.count[i].max(1));
+        self.sum[i].map(|s| s / n)
+    }
+
+    /// Variance of the mean luminance of pixel `i`: the sample variance over n, with fewer than
+    /// two samples taken as the largest over the image (unknown, so assumed bad).
+    pub fn var_of_mean(&self, i: usize, fallback: f64) -> f64 {
+        let n = self.count[i];
+        if n < 2 {
+            return fallback;
+        }
+        let nf = f64::from(n);
+        let m = (0.212671 * self.sum[i][0] + 0.715160 * self.sum[i][1] + 0.072169 * self.sum[i][2])
+            / nf;
+        let var = ((self.sum_sq[i] - nf * m * m) / (nf - 1.0)).max(0.0);
+        var / nf
+    }
+
+    /// The variance of the mean of every pixel, with the fallback for pixels of < 2 samples.
+    pub fn vars_of_mean(&self) -> Vec<f64> {
+        let known: Vec<f64> = (0..self.count.len())
+            .map(|i| self.var_of_mean(i, f64::NAN))
+            .collect();
+        let worst = known
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        known
+            .into_iter()
+            .map(|v| if v.is_finite() { v } else { worst })
+            .collect()
+    }
+}
+
+/// An image-space adaptive method: where the next samples go and how the image is made.
+pub(crate) trait PixelMethod: Send {
+    /// The plugin's name.
+    const NAME: &'static str;
+
+    /// Each pixel's estimated error (>= 0, finite), to which the next round's samples are
+    /// allocated in proportion.
+    fn error(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<f64>;
+
+    /// The image from the statistics, row-major over the space.
+    fn reconstruct(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<Spectrum>;
+}
+
+/// Rounds of samples over pixels, driven by a [`PixelMethod`].
+pub(crate) struct PixelRounds<M> {
+    method: M,
+    space: RenderingSpace,
+    spp: u32,
+    seed: u64,
+    salt: u64,
+    /// Samples each pixel gets in the round under way.
+    plan: Vec<u32>,
+    /// The next pixel of the plan to emit.
+    cursor: usize,
+    /// Samples not yet planned.
+    unplanned: u64,
+    /// Samples of each adaptive round after the first.
+    round_size: u64,
+    moments: PixelMoments,
+    /// Sample indices given so far per pixel.
+    given: Vec<u32>,
+    rounds: u64,
+    halted: bool,
+}
+
+impl<M: PixelMethod> PixelRounds<M> {
+    /// `spp` samples per pixel on average: `init_spp` in every pixel first, then the rest in
+    /// `rounds` rounds steered by the method.
+    pub(crate) fn new(
+        method: M,
+        space: RenderingSpace,
+        spp: u32,
+        init_spp: u32,
+        rounds: u32,
+        seed: u64,
+        salt: u64,
+    ) -> Self {
+        let pixels = space.pixels() as usize;
+        let init = init_spp.clamp(1, spp);
+        let budget = space.pixels() * u64::from(spp);
+        let rest = budget - space.pixels() * u64::from(init);
+        Self {
+            method,
+            space,
+            spp,
+            seed,
+            salt,
+            plan: vec![init; pixels],
+            cursor: 0,
+            unplanned: rest,
+            round_size: rest.div_ceil(u64::from(rounds.max(1))),
+            moments: PixelMoments::new(pixels),
+            given: vec![0; pixels],
+            rounds: 1,
+            halted: false,
+        }
+    }
+
+    /// Plans the next round from the method's error map; false when nothing is left.
+    fn plan_round(&mut self) -> bool {
+        if self.halted || self.unplanned == 0 {
+            return false;
+        }
+        let n = self.round_size.min(self.unplanned);
+        let error = self.method.error(&self.space, &self.moments);
+        self.plan = allocate(&error, n);
+        self.cursor = 0;
+        self.unplanned -= n;
+        self.rounds += 1;
+        true
+    }
+
+    /// A uniform point in pixel `i` (row-major index) with sample index `index`.
+    fn point(&self, i: usize, index: u32) -> SamplePoint {
+        let p = self.space.pixel(i as u64);
+        let key = pixel_key(p, self.seed, self.salt);
+        let mut rng = Pcg32::new(
+            super::mix64(key ^ super::mix64(u64::from(index))),
+            u64::from(index),
+        );
+        let dims = self.space.dims;
+        let film = [
+            in_pixel(p[0], rng.next_f32()),
+            in_pixel(p[1], rng.next_f32()),
+        ];
+        let time = if dims.time { rng.next_f32() } else { 0.5 };
+        let lens = if dims.lens {
+            [rng.next_f32(), rng.next_f32()]
+        } else {
+            [0.5; 2]
+        };
+        SamplePoint {
+            pixel: p,
+            index,
+            film,
+            time,
+            lens,
+        }
+    }
+}
+
+/// `n` samples allocated in proportion to `weights` (largest remainders get the rest; ties to
+/// the lower index), so the total is exactly `n`. Uniform when every weight is 0.
+pub(crate) fn allocate(weights: &[f64], n: u64) -> Vec<u32> {
+    let total: f64 = weights.iter().filter(|w| w.is_finite()).sum();
+    let uniform = total.is_nan() || total <= 0.0;
+    let share = |w: f64| {
+        if uniform {
+            1.0 / weights.len() as f64
+        } else if w.is_finite() {
+            w.max(0.0) / total
+        } else {
+            0.0
+        }
+    };
+    let mut out = Vec::with_capacity(weights.len());
+    let mut frac = Vec::with_capacity(weights.len());
+    let mut given = 0u64;
+    for (i, &w) in weights.iter().enumerate() {
+        let exact = share(w) * n as f64;
+        let whole = exact.floor().min(n as f64) as u64;
+        given += whole;
+        out.push(whole as u32);
+        frac.push((exact - whole as f64, i));
+    }
+    let mut left = n.saturating_sub(given) as usize;
+    if left > 0 {
+        frac.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        // More left than pixels only through rounding of huge totals: go round again.
+        while left > 0 {
+            for &(_, i) in frac.iter().take(left) {
+                out[i] += 1;
+            }
+            left = left.saturating_sub(frac.len());
+        }
+    }
+    out
+}
+
+impl<M: PixelMethod> Sampler for PixelRounds<M> {
+    fn name(&self) -> &'static str {
+        M::NAME
+    }
+
+    fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+        out.clear();
+        if self.cursor >= self.plan.len() && !self.plan_round() {
+            return false;
+        }
+        // Whole pixels in row-major order, about a batch's worth.
+        while self.cursor < self.plan.len() && (out.len() as u64) < BATCH_SAMPLES {
+            let i = self.cursor;
+            for _ in 0..self.plan[i] {
+                out.push(self.point(i, self.given[i]));
+                self.given[i] += 1;
+            }
+            self.cursor += 1;
+        }
+        if out.is_empty() {
+            // A round that planned nothing for the rest of the image.
+            return self.next_batch(out);
+        }
+        true
+    }
+
+    fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        let w = self.space.width() as usize;
+        for (q, l) in batch.iter().zip(radiance) {
+            if !l.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            let i =
+                (q.pixel[1] - self.space.y0) as usize * w + (q.pixel[0] - self.space.x0) as usize;
+            let m = &mut self.moments;
+            m.count[i] += 1;
+            for c in 0..3 {
+                m.sum[i][c] += f64::from(l[c]);
+            }
+            let y = f64::from(luminance(Spectrum::from_array(*l)));
+            m.sum_sq[i] += y * y;
+        }
+    }
+
+    fn halt(&mut self) {
+        // The first round is every pixel's share; after it, no more rounds.
+        self.halted = true;
+    }
+
+    fn report(&self) -> super::SamplerReport {
+        super::SamplerReport {
+            rounds: Some(self.rounds),
+            ..Default::default()
+        }
+    }
+
+    fn reconstructs(&self) -> bool {
+        true
+    }
+
+    fn reconstruct(&self, _film: &Film) -> Option<Vec<Spectrum>> {
+        Some(self.method.reconstruct(&self.space, &self.moments))
+    }
+}
