@@ -720,6 +720,62 @@ fn plugins_used(stats: &serde_json::Value) -> [String; 3] {
     ["sampler", "filter", "integrator"].map(|k| stats[k].as_str().unwrap_or("?").to_owned())
 }
 
+/// The rivals make the image themselves: the stats file names the sampler as the
+/// reconstruction, a filter asked for is reported unused, the budget is spent exactly and the
+/// file is the same with 1 and 2 threads.
+#[test]
+fn the_rivals_reconstruct_the_image_themselves() {
+    let dir = TempDir::new("rivals");
+    let scene = dir.write("s.pbrt", &small_scene(""));
+    for name in ["mdas", "gem", "awr"] {
+        let (a, b) = (
+            dir.join(format!("{name}1.exr")),
+            dir.join(format!("{name}2.exr")),
+        );
+        let stats = dir.join(format!("{name}.json"));
+        let o = render_ok(
+            &scene,
+            &a,
+            &[
+                "--sampler",
+                name,
+                "--filter",
+                "gaussian",
+                "--spp",
+                "6",
+                "--threads",
+                "1",
+                "--stats",
+                stats.to_str().unwrap(),
+            ],
+        );
+        assert!(
+            stderr(&o).contains(&format!(
+                "the {name} sampler reconstructs the image itself; filter \"gaussian\" is not used"
+            )),
+            "{}",
+            stderr(&o)
+        );
+        let s = read_stats(&stats);
+        assert_eq!(plugins_used(&s)[..2], [name.to_owned(), name.to_owned()]);
+        assert_eq!(s["samples"], 24 * 16 * 6, "{name}: budget");
+        assert!(
+            s["rounds"].as_u64().unwrap_or(0) >= 2,
+            "{name}: adaptive rounds"
+        );
+        render_ok(
+            &scene,
+            &b,
+            &["--sampler", name, "--spp", "6", "--threads", "2"],
+        );
+        assert_eq!(
+            std::fs::read(&a).unwrap(),
+            std::fs::read(&b).unwrap(),
+            "{name}: 1 and 2 threads differ"
+        );
+    }
+}
+
 #[test]
 fn plugins_come_from_the_scene_and_the_command_line_overrides_them() {
     let dir = TempDir::new("plugins");

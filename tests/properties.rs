@@ -9,15 +9,22 @@ use acr::transform::MotionTransform;
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use proptest::prelude::*;
 
-/// Largest entry-wise difference, relative to the larger matrix's largest entry.
-fn rel_diff(a: &Mat4, b: &Mat4) -> f32 {
+/// Largest entry-wise difference of `a` and `b`, relative to `size`.
+fn rel_diff(a: &Mat4, b: &Mat4, size: f32) -> f32 {
     let (a, b) = (a.to_cols_array(), b.to_cols_array());
-    let size = a.iter().chain(&b).fold(0.0f32, |m, x| m.max(x.abs()));
     let diff = a
         .iter()
         .zip(&b)
         .fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
     diff / size.max(1e-30)
+}
+
+/// The largest entry of either matrix.
+fn largest(a: &DMat4, b: &DMat4) -> f32 {
+    a.to_cols_array()
+        .iter()
+        .chain(&b.to_cols_array())
+        .fold(0.0f64, |m, x| m.max(x.abs())) as f32
 }
 
 /// A unit axis from three numbers (z when they are all near zero).
@@ -49,7 +56,13 @@ fn affine() -> impl Strategy<Value = DMat4> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(512))]
+    #![proptest_config(ProptestConfig {
+        cases: 512,
+        // Fixed: CI runs the same cases every time (a failure reproduces); change the seed
+        // to explore further.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0xacc0_5eed),
+        ..ProptestConfig::default()
+    })]
 
     /// A point, a vector and a normal taken through a transform and its inverse come back.
     #[test]
@@ -119,16 +132,18 @@ proptest! {
         prop_assert_eq!(motion.at(t1 as f32), end.as_mat4());
         prop_assert_eq!(motion.at(t0 as f32 - 1.0), start.as_mat4());
         prop_assert_eq!(motion.at(t1 as f32 + 1.0), end.as_mat4());
-        // Just inside the shutter the interpolation's own recomposition is used.
+        // Just inside the shutter the interpolation's own recomposition is used; it may move
+        // by up to 1e-4 of the motion (the largest entry of either end) from the end.
+        let size = largest(&start, &end);
         let eps = (length * 1e-4) as f32;
         let near_start = motion.at(t0 as f32 + eps);
         let near_end = motion.at(t1 as f32 - eps);
         prop_assert!(
-            rel_diff(&near_start, &start.as_mat4()) < 2e-3,
+            rel_diff(&near_start, &start.as_mat4(), size) < 2e-3,
             "start {:?} vs {:?}", near_start, start.as_mat4()
         );
         prop_assert!(
-            rel_diff(&near_end, &end.as_mat4()) < 2e-3,
+            rel_diff(&near_end, &end.as_mat4(), size) < 2e-3,
             "end {:?} vs {:?}", near_end, end.as_mat4()
         );
         // In between it stays finite.

@@ -43,7 +43,13 @@ fn spaces() -> impl Strategy<Value = RenderingSpace> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        // Fixed: CI runs the same cases every time (a failure reproduces); change the seed
+        // to explore further.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0xacc0_5eed),
+        ..ProptestConfig::default()
+    })]
 
     /// Every point lies in its pixel's raster square and inside the space, time and lens in
     /// [0, 1) (0.5 when inactive), a pixel's indices are 0, 1, 2, ... in order (they key the
@@ -161,7 +167,13 @@ fn clusters() -> impl Strategy<Value = (Vec<FitCell>, usize)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(ProptestConfig {
+        cases: 256,
+        // Fixed: CI runs the same cases every time (a failure reproduces); change the seed
+        // to explore further.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0xacc0_5eed),
+        ..ProptestConfig::default()
+    })]
 
     /// The fit's value over every cell and over boxes reaching outside the cluster is finite
     /// and non-negative, and, where it clamps, within the range of the usable cell means.

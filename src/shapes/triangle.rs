@@ -754,7 +754,13 @@ mod tests {
     }
 
     proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2048))]
+        #![proptest_config(proptest::prelude::ProptestConfig {
+        cases: 2048,
+        // Fixed: CI runs the same cases every time (a failure reproduces); change the seed
+        // to explore further.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0xacc0_5eed),
+        ..proptest::prelude::ProptestConfig::default()
+    })]
 
         /// Property: a closed mesh placed anywhere (rotated, scaled from 1e-3 to 1e4, up to
         /// 1e6 from the origin, at least 1e-4 of its distance across) has no cracks: a ray from outside, aimed through a vertex or a
