@@ -226,7 +226,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
             ParamSpec::new(
                 "initspp",
                 ParamType::Integer,
-                "spp/4, at least 2",
+                "spp/4, from 2 up to spp",
                 "samples per pixel of the first, uniform round",
             ),
             ParamSpec::new(
