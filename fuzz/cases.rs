@@ -43,12 +43,15 @@ fn built(data: &[u8]) -> Option<(acr::scene::Scene, acr::registry::Plugins)> {
     film.max_sample_luminance = scene.film.max_sample_luminance;
     film.max_component_value = scene.film.max_component_value;
     scene.film = film;
-    let setup = || acr_plugins::SamplerSetup {
-        space: acr::render::rendering_space(&scene),
-        spp: Some(1),
-        seed: 0,
-    };
-    let plugins = acr::registry::choose(&desc, &Default::default(), setup, &mut warnings).ok()?;
+    let plugins = acr::registry::choose_for_scene(
+        &desc,
+        &scene,
+        &Default::default(),
+        Some(1),
+        0,
+        &mut warnings,
+    )
+    .ok()?;
     Some((scene, plugins))
 }
 

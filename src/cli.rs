@@ -2,11 +2,11 @@
 
 use crate::aov::{parse_aovs, write_aov, AovRequest};
 use crate::image_io::{write_image, RgbImage};
-use crate::registry::{choose, Overrides};
-use crate::render::{render, rendering_space, MAX_SPP};
+use crate::registry::{choose_for_scene, Overrides};
+use crate::render::{render, MAX_SPP};
 use crate::scene::Scene;
 use crate::stats::{peak_rss_mb, Seconds, Stats};
-use acr_plugins::{SamplerSetup, Setting};
+use acr_plugins::Setting;
 use clap::{Parser, Subcommand};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -169,12 +169,15 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             .collect::<Result<_, _>>()
             .map_err(|e| e.to_string())?,
     };
-    let setup = || SamplerSetup {
-        space: rendering_space(&scene),
-        spp: args.spp,
-        seed: args.seed,
-    };
-    let mut plugins = choose(&desc, &overrides, setup, &mut warnings).map_err(|e| e.to_string())?;
+    let mut plugins = choose_for_scene(
+        &desc,
+        &scene,
+        &overrides,
+        args.spp,
+        args.seed,
+        &mut warnings,
+    )
+    .map_err(|e| e.to_string())?;
     if let Some(a) = &desc.accelerator {
         // acr has one acceleration structure; pbrt-v3's choice of its own is moot.
         for p in a.params.iter() {

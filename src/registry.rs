@@ -169,6 +169,24 @@ pub fn choose(
     })
 }
 
+/// [`choose`] for a built scene: the sampler covers the scene's rendering space, with the
+/// command line's `spp` (if any) and `seed`.
+pub fn choose_for_scene(
+    desc: &SceneDescription,
+    scene: &crate::scene::Scene,
+    overrides: &Overrides,
+    spp: Option<u32>,
+    seed: u64,
+    warnings: &mut Vec<Warning>,
+) -> Result<Plugins> {
+    let setup = || SamplerSetup {
+        space: crate::render::rendering_space(scene),
+        spp,
+        seed,
+    };
+    choose(desc, overrides, setup, warnings)
+}
+
 /// `acr plugins`: every plugin by kind, with its parameters and defaults, as text.
 pub fn describe() -> String {
     let mut out = String::new();

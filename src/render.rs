@@ -94,7 +94,6 @@ pub fn render_with(
     let mut radiance: Vec<[f32; 3]> = Vec::new();
     let mut valid: Vec<(Vec2, Spectrum)> = Vec::new();
     let mut in_sampler = Duration::ZERO;
-    let limits = film.settings().clone();
     loop {
         let t = Instant::now();
         let more = sampler.next_batch(&mut batch);
@@ -122,7 +121,7 @@ pub fn render_with(
         for (q, &(l, rays)) in batch.iter().zip(&results) {
             counts.rays += u64::from(rays);
             if is_valid_radiance(l) {
-                let l = limits.clamp(l);
+                let l = film.settings().clamp(l);
                 valid.push((Vec2::from(q.film), l));
                 radiance.push(l.to_array());
             } else {

@@ -3,10 +3,9 @@
 
 use acr::geometry::Spectrum;
 use acr::parser::{parse_file, parse_str, Param, ParamType, SceneDescription, Values};
-use acr::registry::{choose, Overrides};
-use acr::render::{render, rendering_space};
+use acr::registry::{choose_for_scene, Overrides};
+use acr::render::render;
 use acr::scene::Scene;
-use acr_plugins::SamplerSetup;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -44,13 +43,15 @@ struct Rendered {
 fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> Rendered {
     let mut warnings = Vec::new();
     let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let setup = || SamplerSetup {
-        space: rendering_space(&scene),
-        spp: Some(spp),
+    let mut plugins = choose_for_scene(
+        desc,
+        &scene,
+        &Overrides::default(),
+        Some(spp),
         seed,
-    };
-    let mut plugins =
-        choose(desc, &Overrides::default(), setup, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+        &mut warnings,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let mut film = plugins.film(&scene);
     let counts = render(
         &scene,

@@ -8,10 +8,9 @@
 
 use acr::geometry::Spectrum;
 use acr::parser::{parse_str, Warning};
-use acr::registry::{choose, Overrides, Plugins};
-use acr::render::{render, render_with, rendering_space, RenderCounts};
+use acr::registry::{choose_for_scene, Overrides, Plugins};
+use acr::render::{render, render_with, RenderCounts};
 use acr::scene::Scene;
-use acr_plugins::SamplerSetup;
 use std::path::Path;
 
 /// The scene `text` built, its plugins chosen with `overrides` at `spp`, and its warnings.
@@ -19,12 +18,8 @@ fn build(text: &str, overrides: &Overrides, spp: u32) -> (Scene, Plugins, Vec<Wa
     let desc = parse_str(text, Path::new("stress.pbrt")).unwrap_or_else(|e| panic!("{e}"));
     let mut warnings = desc.warnings.clone();
     let scene = Scene::build(&desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let setup = || SamplerSetup {
-        space: rendering_space(&scene),
-        spp: Some(spp),
-        seed: 7,
-    };
-    let plugins = choose(&desc, overrides, setup, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+    let plugins = choose_for_scene(&desc, &scene, overrides, Some(spp), 7, &mut warnings)
+        .unwrap_or_else(|e| panic!("{e}"));
     (scene, plugins, warnings)
 }
 

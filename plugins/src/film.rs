@@ -224,14 +224,14 @@ pub struct Film {
 /// pixels (wider ones splat through [`Splat::row`]).
 const MAX_SPAN: usize = 8;
 
-/// A sample ready to splat: what does not depend on the film row (the clamped radiance, the
+/// A sample ready to splat: what does not depend on the film row (the radiance, the
 /// columns reached and their filter-table columns), computed once for the several rows a
 /// sample reaches.
 #[derive(Clone, Copy, Debug)]
 struct Prepared {
     /// Raster position.
     p: Vec2,
-    /// Radiance after the luminance clamp.
+    /// Radiance.
     l: Spectrum,
     /// First film column reached (within the crop).
     x0: i64,
@@ -249,7 +249,6 @@ struct Splat {
     table: [f32; TABLE_SIZE * TABLE_SIZE],
     radius: (f32, f32),
     columns: (i64, i64),
-    limits: FilmSettings,
 }
 
 impl Splat {
@@ -302,13 +301,7 @@ impl Splat {
             *slot = table_index((x as f32 - dx).abs() / rx);
             n += 1;
         }
-        Prepared {
-            p,
-            l: self.clamped(l),
-            x0,
-            n,
-            fx,
-        }
+        Prepared { p, l, x0, n, fx }
     }
 
     /// [`Splat::row`] for a prepared sample: the same contributions, in the same order.
@@ -333,12 +326,6 @@ impl Splat {
                 cell[3] += wf;
             }
         }
-    }
-
-    /// The radiance after the film's limits ([`FilmSettings::clamp`]).
-    #[inline]
-    fn clamped(&self, l: Spectrum) -> Spectrum {
-        self.limits.clamp(l)
     }
 }
 
@@ -393,7 +380,6 @@ impl Film {
                 table,
                 radius: (rx, ry),
                 columns: (cx0 as i64, cx1 as i64),
-                limits: settings.clone(),
             },
             settings,
             prepared: Vec::new(),
@@ -437,14 +423,15 @@ impl Film {
 
     /// Adds a sample at raster position `p` (full-resolution pixels) with radiance `l`, into
     /// every pixel whose centre is within the filter radius (pbrt-v3's Film::AddSample, with
-    /// its tabulated filter).
+    /// its tabulated filter). The radiance is taken as given: the render loop applies the
+    /// film's limits ([`FilmSettings::clamp`]) once, before the sampler, the cells and the film
+    /// see a sample.
     pub fn add_sample(&mut self, p: Vec2, l: Spectrum) {
         let [_, _, cy0, cy1] = self.settings.crop;
         let ry = self.splat.radius.1;
         let dy = p.y - 0.5;
         let y0 = ((dy - ry).ceil() as i64).max(cy0 as i64);
         let y1 = ((dy + ry).floor() as i64 + 1).min(cy1 as i64);
-        let l = self.splat.clamped(l);
         let w = self.settings.size().0 as usize;
         if let Some(i) = self.pixel_index(p) {
             self.stats[i].add(l);
@@ -514,7 +501,7 @@ impl Film {
                 let from = samples.partition_point(|(p, _)| p.y.floor() < top);
                 let to = samples.partition_point(|(p, _)| p.y.floor() <= bottom);
                 for &(p, l) in &samples[from..to] {
-                    splat.row(row, y, p, splat.clamped(l));
+                    splat.row(row, y, p, l);
                 }
             });
     }
@@ -524,7 +511,6 @@ impl Film {
         use rayon::prelude::*;
         let [cx0, cx1, cy0, _] = self.settings.crop;
         let w = (cx1 - cx0) as usize;
-        let splat = &self.splat;
         self.stats
             .par_chunks_mut(w)
             .enumerate()
@@ -535,7 +521,7 @@ impl Film {
                 for &(p, l) in &samples[from..to] {
                     let x = p.x.floor();
                     if x >= cx0 as f32 && x < cx1 as f32 {
-                        row[(x - cx0 as f32) as usize].add(splat.clamped(l));
+                        row[(x - cx0 as f32) as usize].add(l);
                     }
                 }
             });

@@ -7,8 +7,11 @@ use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::SamplerOutput;
 use acr_plugins::rng::mix64;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
-use acr_plugins::{Choice, Filter, Sampler, SamplerSetup, Setting, FILTERS, SAMPLERS};
+use acr_plugins::{Choice, Filter, Sampler, Setting, FILTERS};
 use glam::{Vec2, Vec3};
+
+mod common;
+use common::sampler;
 
 const W: u32 = 64;
 const H: u32 = 48;
@@ -48,16 +51,6 @@ fn filter(name: &str) -> Box<dyn Filter> {
     (e.build)(&Choice::new(None, name, None)).unwrap()
 }
 
-fn sampler(name: &str, spp: u32, seed: u64) -> Box<dyn Sampler> {
-    let e = SAMPLERS.iter().find(|e| e.info.name == name).unwrap();
-    let setup = SamplerSetup {
-        space: space(),
-        spp: Some(spp),
-        seed,
-    };
-    (e.build)(&Choice::new(None, name, None), &setup).unwrap()
-}
-
 /// The image `f` makes from the samples of `s` on the field.
 fn render(mut s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
     let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
@@ -93,7 +86,7 @@ fn rms(sampler_name: &str, filter_name: &str, spp: u32) -> (f64, f64) {
     let f = filter(filter_name);
     let (mut all, mut edge, mut n, mut ne) = (0.0, 0.0, 0usize, 0usize);
     for seed in 1..=4 {
-        let img = render(sampler(sampler_name, spp, seed), f.as_ref());
+        let img = render(sampler(sampler_name, space(), spp, seed), f.as_ref());
         for py in 0..H {
             for px in 0..W {
                 let v = f64::from(img[(py * W + px) as usize].x);
@@ -175,9 +168,9 @@ fn the_filter_grows_its_own_clusters_when_given_omega() {
     }
     let own = (e.build)(&c).unwrap();
     let fitted = |f: &dyn Filter| -> u64 { f.report().fitted_by_degree.unwrap().iter().sum() };
-    let a = render(sampler("cluster", 16, 3), default.as_ref());
+    let a = render(sampler("cluster", space(), 16, 3), default.as_ref());
     let n_default = fitted(default.as_ref());
-    let b = render(sampler("cluster", 16, 3), own.as_ref());
+    let b = render(sampler("cluster", space(), 16, 3), own.as_ref());
     let n_own = fitted(own.as_ref());
     println!("clusters fitted: the sampler's {n_default}, the filter's own {n_own}");
     assert!(

@@ -6,22 +6,11 @@
 use acr_plugins::cluster::grid::MAX_DIMS;
 use acr_plugins::regression::{Fit, FitCell, FitSettings};
 use acr_plugins::space::{Dims, RenderingSpace};
-use acr_plugins::{Choice, Sampler, SamplerSetup, SAMPLERS};
+use acr_plugins::SAMPLERS;
 use proptest::prelude::*;
 
-/// The sampler `name` on `space` at `spp`, built through the registry.
-fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dyn Sampler> {
-    let e = SAMPLERS
-        .iter()
-        .find(|e| e.info.name == name)
-        .unwrap_or_else(|| panic!("no sampler {name}"));
-    let setup = SamplerSetup {
-        space,
-        spp: Some(spp),
-        seed,
-    };
-    (e.build)(&Choice::new(None, name, None), &setup).unwrap()
-}
+mod common;
+use common::sampler;
 
 /// A cropped rendering space anywhere in a large image, with any dims.
 fn spaces() -> impl Strategy<Value = RenderingSpace> {

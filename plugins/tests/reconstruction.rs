@@ -9,9 +9,12 @@
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::SamplerOutput;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
-use acr_plugins::{Choice, Filter, FilterKernel, Sampler, SamplerSetup, FILTERS, SAMPLERS};
+use acr_plugins::{Choice, Filter, FilterKernel, Sampler, FILTERS, SAMPLERS};
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
+
+mod common;
+use common::sampler;
 
 // ------------------------------------------------------------------------------------------
 // Registry helpers.
@@ -35,20 +38,6 @@ fn default_param(filter: &str, param: &str) -> f64 {
         .find(|p| p.name == param)
         .unwrap_or_else(|| panic!("{filter} has no parameter {param}"));
     p.default.parse().unwrap()
-}
-
-/// The sampler `name` at `spp`, built through the registry as the command line's `--spp` does.
-fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dyn Sampler> {
-    let e = SAMPLERS
-        .iter()
-        .find(|e| e.info.name == name)
-        .unwrap_or_else(|| panic!("no sampler {name}"));
-    let setup = SamplerSetup {
-        space,
-        spp: Some(spp),
-        seed,
-    };
-    (e.build)(&Choice::new(None, name, None), &setup).unwrap()
 }
 
 /// Every point a sampler gives, batch by batch.

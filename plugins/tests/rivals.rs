@@ -8,8 +8,11 @@
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::rng::mix64;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
-use acr_plugins::{Choice, Sampler, SamplerSetup, FILTERS, SAMPLERS};
+use acr_plugins::{Choice, FILTERS};
 use glam::{Vec2, Vec3};
+
+mod common;
+use common::sampler;
 
 const W: u32 = 64;
 const H: u32 = 48;
@@ -87,19 +90,9 @@ impl Edge {
     }
 }
 
-fn sampler(name: &str, dims: Dims, spp: u32, seed: u64) -> Box<dyn Sampler> {
-    let e = SAMPLERS.iter().find(|e| e.info.name == name).unwrap();
-    let setup = SamplerSetup {
-        space: RenderingSpace::whole(W, H, dims),
-        spp: Some(spp),
-        seed,
-    };
-    (e.build)(&Choice::new(None, name, None), &setup).unwrap()
-}
-
 /// Runs `name` on `edge` at `spp`: the image it reconstructs and the points per pixel.
 fn run(name: &str, edge: Edge, spp: u32, seed: u64) -> (Vec<Vec3>, Vec<u32>) {
-    let mut s = sampler(name, edge.dims(), spp, seed);
+    let mut s = sampler(name, RenderingSpace::whole(W, H, edge.dims()), spp, seed);
     assert!(s.reconstructs(), "{name} reconstructs itself");
     let box_filter = FILTERS.iter().find(|e| e.info.name == "box").unwrap();
     let kernel = (box_filter.build)(&Choice::new(None, "box", None)).unwrap();

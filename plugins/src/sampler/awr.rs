@@ -11,10 +11,10 @@
 // Channel and dim loops index several small arrays at once, as the formulas do.
 #![allow(clippy::needless_range_loop)]
 
-use super::pixel_rounds::{PixelMethod, PixelMoments, PixelRounds};
+use super::pixel_rounds::{self, PixelMethod, PixelMoments};
 use super::{SamplerBuild, SamplerSetup};
 use crate::film::Spectrum;
-use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::registry::{float_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::RenderingSpace;
 use acr_parser::{ParamType, Result};
 
@@ -185,26 +185,10 @@ impl PixelMethod for Awr {
 
 fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn super::Sampler>> {
     let p = &c.params;
-    let spp = super::pixel_samples(p, setup)?;
-    let init = int_in(
-        p,
-        "initspp",
-        (spp / 4).max(2).min(spp) as i32,
-        1..=i64::from(spp),
-    )?;
-    let rounds = int_in(p, "rounds", 4, 1..=64)?;
     let method = Awr {
         threshold: float_in(p, "threshold", 1.0, 0.0..=100.0)?,
     };
-    Ok(Box::new(PixelRounds::new(
-        method,
-        setup.space,
-        spp,
-        init.min(spp),
-        rounds,
-        setup.seed,
-        SALT,
-    )))
+    pixel_rounds::build(method, p, setup, SALT)
 }
 
 /// The registry's entry.
@@ -217,24 +201,9 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
               coefficients with detail and variance, soft-thresholded reconstruction; \
               reconstructs the image itself",
         params: &[
-            ParamSpec::new(
-                "pixelsamples",
-                ParamType::Integer,
-                "16",
-                "samples per pixel on average (--spp overrides)",
-            ),
-            ParamSpec::new(
-                "initspp",
-                ParamType::Integer,
-                "spp/4, from 2 up to spp",
-                "samples per pixel of the first, uniform round",
-            ),
-            ParamSpec::new(
-                "rounds",
-                ParamType::Integer,
-                "4",
-                "adaptive rounds after it",
-            ),
+            pixel_rounds::ROUND_PARAMS[0],
+            pixel_rounds::ROUND_PARAMS[1],
+            pixel_rounds::ROUND_PARAMS[2],
             ParamSpec::new(
                 "threshold",
                 ParamType::Float,

@@ -591,12 +591,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
               reconstruction by integrating the leaves' means over each pixel; reconstructs the \
               image itself",
         params: &[
-            ParamSpec::new(
-                "pixelsamples",
-                ParamType::Integer,
-                "16",
-                "samples per pixel on average (--spp overrides)",
-            ),
+            super::PIXELSAMPLES_ON_AVERAGE,
             ParamSpec::new(
                 "initspp",
                 ParamType::Integer,

@@ -25,7 +25,7 @@ use crate::partition::Partition;
 use crate::registry::{Choice, Entry};
 pub(crate) use crate::rng::{mix64, Pcg32};
 use crate::space::{RenderingSpace, SamplePoint};
-use acr_parser::{Error, ParamList, Result};
+use acr_parser::{Error, ParamList, ParamType, Result};
 use std::ops::Range;
 
 /// Samples per batch: enough to keep every thread busy, few enough to report progress often.
@@ -153,6 +153,15 @@ pub(crate) fn check_count(params: &ParamList, name: &str, v: i64) -> Result<u32>
 
 /// Doc of `pixelsamples`.
 pub(crate) const PIXELSAMPLES: &str = "samples per pixel (--spp overrides)";
+
+/// `pixelsamples` of an adaptive sampler, whose pixels get unequal shares of the budget.
+pub(crate) const PIXELSAMPLES_ON_AVERAGE: crate::registry::ParamSpec =
+    crate::registry::ParamSpec::new(
+        "pixelsamples",
+        ParamType::Integer,
+        "16",
+        "samples per pixel on average (--spp overrides)",
+    );
 
 /// Walks a space's pixels in passes: each pass gives every pixel the next few sample indices
 /// (as many as keep a pass near a batch), in batches of whole pixels, row-major. Between

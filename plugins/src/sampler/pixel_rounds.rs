@@ -5,9 +5,11 @@
 // Channel and dim loops index several small arrays at once, as the formulas do.
 #![allow(clippy::needless_range_loop)]
 
-use super::{pixel_key, Pcg32, Sampler, BATCH_SAMPLES};
+use super::{pixel_key, Sampler, SamplerSetup, BATCH_SAMPLES};
 use crate::film::{luminance, Film, Spectrum};
-use crate::space::{in_pixel, RenderingSpace, SamplePoint};
+use crate::registry::{int_in, ParamSpec};
+use crate::space::{RenderingSpace, SamplePoint};
+use acr_parser::{ParamList, ParamType, Result};
 
 /// Per-pixel running statistics of the samples a sampler has seen (dropped ones excluded).
 #[derive(Clone, Debug, Default)]
@@ -152,29 +154,52 @@ impl<M: PixelMethod> PixelRounds<M> {
     fn point(&self, i: usize, index: u32) -> SamplePoint {
         let p = self.space.pixel(i as u64);
         let key = pixel_key(p, self.seed, self.salt);
-        let mut rng = Pcg32::new(
-            super::mix64(key ^ super::mix64(u64::from(index))),
-            u64::from(index),
-        );
-        let dims = self.space.dims;
-        let film = [
-            in_pixel(p[0], rng.next_f32()),
-            in_pixel(p[1], rng.next_f32()),
-        ];
-        let time = if dims.time { rng.next_f32() } else { 0.5 };
-        let lens = if dims.lens {
-            [rng.next_f32(), rng.next_f32()]
-        } else {
-            [0.5; 2]
-        };
-        SamplePoint {
-            pixel: p,
-            index,
-            film,
-            time,
-            lens,
-        }
+        super::random::uniform_point(p, index, key, self.space.dims)
     }
+}
+
+/// The parameters every image-space adaptive method declares first.
+pub(crate) const ROUND_PARAMS: [ParamSpec; 3] = [
+    super::PIXELSAMPLES_ON_AVERAGE,
+    ParamSpec::new(
+        "initspp",
+        ParamType::Integer,
+        "spp/4, from 2 up to spp",
+        "samples per pixel of the first, uniform round",
+    ),
+    ParamSpec::new(
+        "rounds",
+        ParamType::Integer,
+        "4",
+        "adaptive rounds after it",
+    ),
+];
+
+/// The sampler of `method`, its budget, first round and rounds read from `params` (the
+/// [`ROUND_PARAMS`]).
+pub(crate) fn build<M: PixelMethod + 'static>(
+    method: M,
+    params: &ParamList,
+    setup: &SamplerSetup,
+    salt: u64,
+) -> Result<Box<dyn Sampler>> {
+    let spp = super::pixel_samples(params, setup)?;
+    let init = int_in(
+        params,
+        "initspp",
+        (spp / 4).max(2).min(spp) as i32,
+        1..=i64::from(spp),
+    )?;
+    let rounds = int_in(params, "rounds", 4, 1..=64)?;
+    Ok(Box::new(PixelRounds::new(
+        method,
+        setup.space,
+        spp,
+        init,
+        rounds,
+        setup.seed,
+        salt,
+    )))
 }
 
 /// `n` samples allocated in proportion to `weights` (largest remainders get the rest; ties to

@@ -3,7 +3,7 @@
 use super::{pixel_key, Pcg32, PixelCursor, PixelPattern, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
-use crate::space::{in_pixel, RenderingSpace, SamplePoint};
+use crate::space::{in_pixel, Dims, RenderingSpace, SamplePoint};
 use acr_parser::{ParamType, Result};
 
 /// Salt of this sampler's per-pixel keys.
@@ -40,34 +40,38 @@ impl PixelPattern for RandomSampler {
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
         let dims = self.cursor.space().dims;
         let key = pixel_key(p, self.seed, SALT);
-        for index in indices {
-            // A generator per sample, so that any pass can start at any index; the index is
-            // hashed into the seed, since PCG streams of one seed that differ only in their
-            // increment start out correlated (measured: the variance of a pixel's mean was
-            // 0.65x to 1.08x that of independent points).
-            let mut rng = Pcg32::new(
-                super::mix64(key ^ super::mix64(u64::from(index))),
-                u64::from(index),
-            );
-            let film = [
-                in_pixel(p[0], rng.next_f32()),
-                in_pixel(p[1], rng.next_f32()),
-            ];
-            // Inactive dims draw nothing: a pinhole still scene pays for x and y only.
-            let time = if dims.time { rng.next_f32() } else { 0.5 };
-            let lens = if dims.lens {
-                [rng.next_f32(), rng.next_f32()]
-            } else {
-                [0.5; 2]
-            };
-            out.push(SamplePoint {
-                pixel: p,
-                index,
-                film,
-                time,
-                lens,
-            });
-        }
+        out.extend(indices.map(|index| uniform_point(p, index, key, dims)));
+    }
+}
+
+/// Point `index` of pixel `p`: uniform over the pixel and the active dims, drawn from the
+/// pixel's `key` (also the image-space adaptive samplers' points, with their own keys).
+pub(crate) fn uniform_point(p: [u32; 2], index: u32, key: u64, dims: Dims) -> SamplePoint {
+    // A generator per sample, so that any pass can start at any index; the index is hashed
+    // into the seed, since PCG streams of one seed that differ only in their increment start
+    // out correlated (measured: the variance of a pixel's mean was 0.65x to 1.08x that of
+    // independent points).
+    let mut rng = Pcg32::new(
+        super::mix64(key ^ super::mix64(u64::from(index))),
+        u64::from(index),
+    );
+    let film = [
+        in_pixel(p[0], rng.next_f32()),
+        in_pixel(p[1], rng.next_f32()),
+    ];
+    // Inactive dims draw nothing: a pinhole still scene pays for x and y only.
+    let time = if dims.time { rng.next_f32() } else { 0.5 };
+    let lens = if dims.lens {
+        [rng.next_f32(), rng.next_f32()]
+    } else {
+        [0.5; 2]
+    };
+    SamplePoint {
+        pixel: p,
+        index,
+        film,
+        time,
+        lens,
     }
 }
 
