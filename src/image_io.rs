@@ -275,11 +275,22 @@ pub fn write_image(path: &Path, img: &RgbImage) -> Result<(), String> {
 }
 
 fn write_exr(path: &Path, img: &RgbImage) -> Result<(), String> {
-    exr::prelude::write_rgb_file(path, img.width, img.height, |x, y| {
+    use exr::prelude::*;
+    // Tiles are compressed on several threads; an increasing line order makes the writer put
+    // them in the file in order, so the bytes do not depend on which thread finishes first
+    // (exr's default, unspecified order, writes them as they come).
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let channels = SpecificChannels::rgb(|Vec2(x, y)| {
         let c = img.get(x, y);
         (c.x, c.y, c.z)
-    })
-    .map_err(|e| e.to_string())
+    });
+    Image::from_encoded_channels((img.width, img.height), encoding, channels)
+        .write()
+        .to_file(path)
+        .map_err(|e| e.to_string())
 }
 
 /// pbrt-v3's 8-bit conversion: `Clamp(255 * GammaCorrect(v) + 0.5, 0, 255)`, truncated.
@@ -364,6 +375,29 @@ mod tests {
         let path = dir.0.join("a.exr");
         write_image(&path, &img).unwrap();
         assert_eq!(read_image(&path, true).unwrap(), img);
+    }
+
+    /// The same image gives the same bytes: tiles are compressed on several threads, and the
+    /// file must not depend on which finishes first (a 320x240 render's EXR differed from run
+    /// to run in its tile order before).
+    #[test]
+    fn exr_files_are_the_same_bytes_every_time() {
+        let dir = TempDir::new("exr-same");
+        let mut img = gradient(700, 500);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            // Noise makes the tiles' compression times differ.
+            let h = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
+            *p += Spectrum::splat(h as f32 / (1u64 << 24) as f32);
+        }
+        let first = dir.0.join("0.exr");
+        write_image(&first, &img).unwrap();
+        let want = std::fs::read(&first).unwrap();
+        for k in 1..8 {
+            let path = dir.0.join(format!("{k}.exr"));
+            write_image(&path, &img).unwrap();
+            assert!(std::fs::read(&path).unwrap() == want, "write {k} differs");
+        }
+        assert_eq!(read_image(&first, false).unwrap(), img);
     }
 
     #[test]
