@@ -3,11 +3,13 @@
 //! pixel's own samples' count, sum and sum of squares, for the spp and variance AOVs and for
 //! filters that reconstruct from per-pixel statistics.
 
+use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::filters::FilterKernel;
 use crate::space::SamplePoint;
 use acr_parser::{Error, PluginDesc, Result};
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 /// Linear RGB radiance.
 pub type Spectrum = Vec3;
@@ -218,6 +220,8 @@ pub struct Film {
     /// Per-cell sums over the rendering space, for a reconstruction that fits cells when the
     /// sampler keeps none ([`Film::collect_cells`]).
     cells: Option<(CellGrid, CellSums)>,
+    /// The cell and offsets of each point of the batch being added (reused).
+    located: Vec<(u32, [f32; MAX_DIMS])>,
 }
 
 /// Film columns a [`Prepared`] sample can reach: enough for filters of radius up to 3.5
@@ -384,6 +388,7 @@ impl Film {
             settings,
             prepared: Vec::new(),
             cells: None,
+            located: Vec::new(),
         }
     }
 
@@ -399,12 +404,16 @@ impl Film {
         let Some((grid, sums)) = self.cells.as_mut() else {
             return;
         };
-        for (q, l) in batch.iter().zip(radiance) {
-            if l.iter().all(|v| v.is_finite()) {
+        let grid = &*grid;
+        batch
+            .par_iter()
+            .with_min_len(256)
+            .map(|q| {
                 let (cell, off) = grid.locate(q);
-                sums.add(cell, &off, Spectrum::from_array(*l));
-            }
-        }
+                (cell as u32, off)
+            })
+            .collect_into_vec(&mut self.located);
+        sums.add_batch(&self.located, radiance);
     }
 
     /// The film's cells, when it collects them.

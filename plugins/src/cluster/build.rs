@@ -4,7 +4,7 @@
 //! it on the film's cells after any other sampler.
 
 use super::clusters::distance;
-use super::features::{level, raw};
+use super::features::{level, raw, Squashed};
 use super::{CellGrid, CellSums, Clustering, FeatureScale, Membership};
 use rayon::prelude::*;
 
@@ -26,10 +26,8 @@ pub struct ClusterParams {
 pub struct Initial {
     /// Each cell's level (mean luminance, or its sampled neighbours').
     pub levels: Vec<f32>,
-    /// Each cell's raw gradient feature.
-    pub g: Vec<f32>,
-    /// Each cell's raw variance feature.
-    pub s: Vec<f32>,
+    /// Each cell's squashed gradient, variance and level, from which its feature is made.
+    pub squashed: Vec<Squashed>,
     /// How raw features become weighted feature vectors.
     pub scale: FeatureScale,
     /// The clusters.
@@ -59,7 +57,13 @@ pub fn initial_clustering(grid: &CellGrid, sums: &CellSums, params: &ClusterPara
         unit,
         params.log_features,
     );
-    let feature = |i: usize| scale.feature(n, &grid.coords(i), g[i], s[i], levels[i]);
+    let squashed: Vec<Squashed> = (0..grid.len())
+        .into_par_iter()
+        .map(|i| scale.squash(g[i], s[i], levels[i]))
+        .collect();
+    // The squashed values hold the logarithms, so a feature is cheap to make again each time
+    // the flood fill below tests a cell.
+    let feature = |i: usize| scale.feature_of(n, &grid.coords(i), squashed[i]);
     // The tolerance of eq. 10 is the typical distance between neighbouring cells' features
     // (the median, over sampled cells, of the distance to the next cell along x): a cluster
     // of one cell then takes neighbours that differ by noise and refuses those that differ by
@@ -92,8 +96,7 @@ pub fn initial_clustering(grid: &CellGrid, sums: &CellSums, params: &ClusterPara
     let clustering = Clustering::grow(grid, rule, feature, |i| u64::from(sums.count[i]));
     Initial {
         levels,
-        g,
-        s,
+        squashed,
         scale,
         clustering,
     }

@@ -268,9 +268,9 @@ impl Clustering {
         (id, Some(target))
     }
 
-    /// Adds `n` spent samples to the cluster of `cell`.
-    pub fn spend(&mut self, cell: usize, n: u64) {
-        self.clusters[self.of_cell[cell] as usize].samples += n;
+    /// Adds `n` spent samples to cluster `id`.
+    pub fn spend(&mut self, id: u32, n: u64) {
+        self.clusters[id as usize].samples += n;
     }
 
     /// Bytes held, for the memory budget.

@@ -4,6 +4,7 @@
 
 use crate::film::{luminance, Spectrum};
 use crate::space::{in_pixel, RenderingSpace, SamplePoint};
+use rayon::prelude::*;
 
 /// Most active dims: x, y, t, u, v.
 pub const MAX_DIMS: usize = 5;
@@ -20,6 +21,8 @@ pub struct CellGrid {
     shape: Coords,
     stride: [usize; MAX_DIMS],
     len: usize,
+    /// Whether cells are whole pixels (cell size 1) with one interval along every other dim.
+    pixel_cells: bool,
 }
 
 impl CellGrid {
@@ -49,6 +52,7 @@ impl CellGrid {
             shape,
             stride,
             len: stride[1] * shape[1] as usize,
+            pixel_cells: cell_size == 1.0 && inner == 1,
         }
     }
 
@@ -85,6 +89,12 @@ impl CellGrid {
     /// Pixels per image cell side.
     pub fn cell_size(&self) -> f64 {
         self.cell_size
+    }
+
+    /// How far apart in index two cells one step apart along `dim` are.
+    #[inline]
+    pub fn stride(&self, dim: usize) -> usize {
+        self.stride[dim]
     }
 
     /// The coordinates of cell `i`.
@@ -185,13 +195,25 @@ impl CellGrid {
         } else {
             1.0 / f64::from(self.shape[dim])
         };
-        ((v / unit).floor().max(0.0) as u32).min(self.shape[dim] - 1)
+        // `as` truncates, which is floor for the non-negative values `max` leaves (and costs
+        // no call to libm's floor on targets without SSE4.1).
+        ((v / unit).max(0.0) as u32).min(self.shape[dim] - 1)
     }
 
     /// The cell a point lies in and its offsets inside the cell, each in [0, 1).
     #[inline]
     pub fn locate(&self, q: &SamplePoint) -> (usize, [f32; MAX_DIMS]) {
         let p = self.position(q);
+        if self.pixel_cells {
+            self.locate_in_pixel_cells(&p)
+        } else {
+            self.locate_at(&p)
+        }
+    }
+
+    /// The cell of position `p` (in the units of [`Self::position`]) and the offsets in it.
+    #[inline]
+    fn locate_at(&self, p: &[f64; MAX_DIMS]) -> (usize, [f32; MAX_DIMS]) {
         let mut c = [0; MAX_DIMS];
         let mut off = [0.0; MAX_DIMS];
         for d in 0..self.n {
@@ -201,6 +223,25 @@ impl CellGrid {
             off[d] = (((p[d] - lo) / (hi - lo)) as f32).clamp(0.0, crate::space::ONE_MINUS_EPSILON);
         }
         (self.index(&c), off)
+    }
+
+    /// [`Self::locate`] when cells are whole pixels with one interval along every other dim:
+    /// the same arithmetic without the divisions by a unit of 1.
+    #[inline]
+    fn locate_in_pixel_cells(&self, p: &[f64; MAX_DIMS]) -> (usize, [f32; MAX_DIMS]) {
+        let mut off = [0.0; MAX_DIMS];
+        let one = crate::space::ONE_MINUS_EPSILON;
+        let kx = (p[0].max(0.0) as u32).min(self.shape[0] - 1);
+        let ky = (p[1].max(0.0) as u32).min(self.shape[1] - 1);
+        off[0] = ((p[0] - f64::from(kx)) as f32).clamp(0.0, one);
+        off[1] = ((p[1] - f64::from(ky)) as f32).clamp(0.0, one);
+        for d in 2..self.n {
+            off[d] = (p[d] as f32).clamp(0.0, one);
+        }
+        (
+            kx as usize * self.stride[0] + ky as usize * self.stride[1],
+            off,
+        )
     }
 
     /// The sample point at offsets `u` (each in [0, 1)) inside cell `i`; its pixel is where it
@@ -217,7 +258,7 @@ impl CellGrid {
         // `locate` sees it.
         let film_axis = |d: usize, origin: u32, limit: u32| {
             let v = p[d];
-            let k = (v.floor().max(0.0) as u32).min(limit.saturating_sub(1));
+            let k = (v.max(0.0) as u32).min(limit.saturating_sub(1));
             let px = origin + k;
             let mut f = in_pixel(px, (v - f64::from(k)).clamp(0.0, 1.0) as f32);
             for _ in 0..8 {
@@ -271,7 +312,7 @@ impl CellGrid {
         std::array::from_fn(|d| {
             let (lo, hi) = self.extent(d, c[d] as u32);
             let v = lo + f64::from(u[d]) * (hi - lo);
-            origin[d] + (v.floor().max(0.0) as u32).min(limit[d].saturating_sub(1))
+            origin[d] + (v.max(0.0) as u32).min(limit[d].saturating_sub(1))
         })
     }
 
@@ -301,6 +342,45 @@ impl CellGrid {
             ((((f64::from(p) + 0.5) / self.cell_size).floor()) as u32).min(self.shape[d] - 1)
         };
         (at(px, 0), at(py, 1))
+    }
+}
+
+/// Fewest samples in a batch worth summing in parallel.
+const PARALLEL_BATCH: usize = 4096;
+
+/// A contiguous run of cells' sums, borrowed for adding samples.
+struct Band<'a> {
+    count: &'a mut [u32],
+    rgb: &'a mut [[f32; 3]],
+    rgb_sq: &'a mut [[f32; 3]],
+    lum: &'a mut [f64],
+    lum_sq: &'a mut [f64],
+    offset: &'a mut [f32],
+    offset_sq: &'a mut [f32],
+    dims: usize,
+}
+
+impl Band<'_> {
+    /// Adds one sample of radiance `l` at offsets `off` to cell `i` of the band.
+    #[inline]
+    fn add(&mut self, i: usize, off: &[f32; MAX_DIMS], l: Spectrum) {
+        self.count[i] += 1;
+        let y = f64::from(luminance(l));
+        self.lum[i] += y;
+        self.lum_sq[i] += y * y;
+        for (c, v) in [l.x, l.y, l.z].into_iter().enumerate() {
+            self.rgb[i][c] += v;
+            self.rgb_sq[i][c] += v * v;
+        }
+        let at = i * self.dims..(i + 1) * self.dims;
+        for ((s, s2), o) in self.offset[at.clone()]
+            .iter_mut()
+            .zip(&mut self.offset_sq[at])
+            .zip(off)
+        {
+            *s += o;
+            *s2 += o * o;
+        }
     }
 }
 
@@ -344,23 +424,91 @@ impl CellSums {
     /// Adds one sample of radiance `l` at offsets `off` to cell `i`.
     #[inline]
     pub fn add(&mut self, i: usize, off: &[f32; MAX_DIMS], l: Spectrum) {
-        self.count[i] += 1;
-        let y = f64::from(luminance(l));
-        self.lum[i] += y;
-        self.lum_sq[i] += y * y;
-        for (c, v) in [l.x, l.y, l.z].into_iter().enumerate() {
-            self.rgb[i][c] += v;
-            self.rgb_sq[i][c] += v * v;
+        self.band(0, self.count.len()).add(i, off, l);
+    }
+
+    /// Adds a batch of samples: the sample in cell `located[k].0` at offsets `located[k].1`
+    /// with radiance `radiance[k]`, skipping radiance that is not finite (a dropped sample).
+    /// Bands of cells are summed in parallel, each cell's samples in batch order, so the sums
+    /// do not depend on the thread count.
+    pub fn add_batch(&mut self, located: &[(u32, [f32; MAX_DIMS])], radiance: &[[f32; 3]]) {
+        let cells = self.count.len();
+        let bands = if located.len() < PARALLEL_BATCH {
+            1
+        } else {
+            (4 * rayon::current_num_threads()).min(cells.max(1))
+        };
+        let band_len = cells.div_ceil(bands).max(1);
+        // Each band's samples, in batch order: one pass, then the bands in parallel.
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); bands];
+        for (k, ((cell, _), l)) in located.iter().zip(radiance).enumerate() {
+            if l.iter().all(|v| v.is_finite()) {
+                members[*cell as usize / band_len].push(k as u32);
+            }
         }
-        let at = i * self.dims..(i + 1) * self.dims;
-        for ((s, s2), o) in self.offset[at.clone()]
-            .iter_mut()
-            .zip(&mut self.offset_sq[at])
-            .zip(off)
-        {
-            *s += o;
-            *s2 += o * o;
+        let add_band = |(start, mut band, members): (usize, Band<'_>, &Vec<u32>)| {
+            for &k in members {
+                let (cell, off) = &located[k as usize];
+                band.add(
+                    *cell as usize - start,
+                    off,
+                    Spectrum::from_array(radiance[k as usize]),
+                );
+            }
+        };
+        if bands == 1 {
+            add_band((0, self.band(0, cells), &members[0]));
+            return;
         }
+        let starts: Vec<usize> = (0..bands).map(|b| b * band_len).collect();
+        let views: Vec<Band<'_>> = self.bands(band_len);
+        starts
+            .into_par_iter()
+            .zip(views)
+            .zip(&members)
+            .map(|((s, b), m)| (s, b, m))
+            .for_each(add_band);
+    }
+
+    /// The sums of cells `start..end` as one band.
+    fn band(&mut self, start: usize, end: usize) -> Band<'_> {
+        let d = self.dims;
+        Band {
+            count: &mut self.count[start..end],
+            rgb: &mut self.rgb[start..end],
+            rgb_sq: &mut self.rgb_sq[start..end],
+            lum: &mut self.lum[start..end],
+            lum_sq: &mut self.lum_sq[start..end],
+            offset: &mut self.offset[start * d..end * d],
+            offset_sq: &mut self.offset_sq[start * d..end * d],
+            dims: d,
+        }
+    }
+
+    /// The sums split into bands of `band_len` cells, in order.
+    fn bands(&mut self, band_len: usize) -> Vec<Band<'_>> {
+        let d = self.dims;
+        self.count
+            .chunks_mut(band_len)
+            .zip(self.rgb.chunks_mut(band_len))
+            .zip(self.rgb_sq.chunks_mut(band_len))
+            .zip(self.lum.chunks_mut(band_len))
+            .zip(self.lum_sq.chunks_mut(band_len))
+            .zip(self.offset.chunks_mut(band_len * d))
+            .zip(self.offset_sq.chunks_mut(band_len * d))
+            .map(
+                |((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq)| Band {
+                    count,
+                    rgb,
+                    rgb_sq,
+                    lum,
+                    lum_sq,
+                    offset,
+                    offset_sq,
+                    dims: d,
+                },
+            )
+            .collect()
     }
 
     /// The mean luminance of cell `i`, if it has samples.
@@ -442,6 +590,30 @@ mod tests {
                     assert!(q.pixel[0] < 10 + w && q.pixel[1] < 20 + h);
                     assert_eq!(g.pixel(i, &u), q.pixel);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn pixel_cells_locate_as_the_general_rule_does() {
+        let mut state = 3u64;
+        let mut next = || {
+            state = crate::rng::mix64(state);
+            (state >> 40) as f64 / (1u64 << 24) as f64
+        };
+        for (time, lens) in [(false, false), (true, false), (true, true)] {
+            let g = CellGrid::new(space(7, 5, time, lens), 1.0, 1);
+            assert!(g.pixel_cells);
+            for _ in 0..2000 {
+                // Inside the space, on its edges and a little outside.
+                let mut p = [0.0; MAX_DIMS];
+                p[0] = next() * 9.0 - 1.0;
+                p[1] = next() * 7.0 - 1.0;
+                for v in &mut p[2..] {
+                    *v = (next() * 1.2 - 0.1) as f32 as f64;
+                }
+                p[0] = (p[0] as f32).floor() as f64 + [0.0, 0.5, next()][(next() * 3.0) as usize];
+                assert_eq!(g.locate_in_pixel_cells(&p), g.locate_at(&p), "{p:?}");
             }
         }
     }

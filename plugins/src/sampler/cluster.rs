@@ -13,11 +13,10 @@ use super::{
 };
 use crate::cluster::build::{initial_clustering, ClusterParams};
 use crate::cluster::clusters::UNASSIGNED;
-use crate::cluster::features::{level, raw, Feature};
+use crate::cluster::features::{level, raw, Squashed};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::queue::{BucketQueue, Queued};
 use crate::cluster::{CellGrid, CellSums, CellView, Cluster, Clustering, FeatureScale};
-use crate::film::Spectrum;
 use crate::partition::Partition;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{RenderingSpace, SamplePoint};
@@ -29,6 +28,9 @@ const SALT: u64 = 0x636c_7573;
 
 /// Fewest and most samples a chosen cluster gets at a time (the paper's "4-16").
 const CLUSTER_SAMPLES: (u64, u64) = (4, 16);
+
+/// Picks one task draws the pixels of, in a round.
+const PICKS_PER_TASK: usize = 64;
 
 /// Smallest round, in samples: enough to keep every thread busy.
 const MIN_ROUND: u64 = 4096;
@@ -120,15 +122,6 @@ impl ClusterSettings {
     }
 }
 
-/// A cell's new raw features and its feature vector before and after.
-struct FeatureChange {
-    cell: u32,
-    g: f32,
-    s: f32,
-    old: Feature,
-    new: Feature,
-}
-
 /// Where the sampler is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
@@ -148,10 +141,9 @@ pub struct ClusterSampler {
     grid: CellGrid,
     sums: CellSums,
     levels: Vec<f32>,
-    g: Vec<f32>,
-    s: Vec<f32>,
-    /// The level each cell's current feature was made with (its level may have moved since).
-    feature_level: Vec<f32>,
+    /// The squashed (g, s, level) each cell's current feature was made with (its level may
+    /// have moved since).
+    squashed: Vec<Squashed>,
     scale: Option<FeatureScale>,
     clustering: Option<Clustering>,
     /// Samples given to each pixel so far: the next sample's index there.
@@ -168,10 +160,14 @@ pub struct ClusterSampler {
     round_cells: Vec<(u32, [f32; MAX_DIMS])>,
     /// The pixel index of each point drawn in a round, in draw order (reused).
     drawn: Vec<u32>,
-    /// Cells that received samples since the last update.
-    touched: Vec<u32>,
-    stamp: Vec<u32>,
-    generation: u32,
+    /// A bit per cell: whether it got samples since the last update.
+    touched: Vec<u64>,
+    /// Cells without samples, as of the last update (their levels follow their neighbours').
+    empty_cells: usize,
+    /// The update's buffers, kept from round to round: fresh ones cost page faults.
+    dirty: Vec<u32>,
+    new_levels: Vec<f32>,
+    changes: Vec<(u32, Squashed)>,
     rounds: u64,
     partition: Option<Partition>,
 }
@@ -200,9 +196,7 @@ impl ClusterSampler {
             grid,
             sums,
             levels: Vec::new(),
-            g: vec![0.0; cells],
-            s: vec![0.0; cells],
-            feature_level: Vec::new(),
+            squashed: Vec::new(),
             scale: None,
             clustering: None,
             pixel_count: vec![0; pixels as usize],
@@ -212,9 +206,11 @@ impl ClusterSampler {
             round_clusters: Vec::new(),
             round_cells: Vec::new(),
             drawn: Vec::new(),
-            touched: Vec::new(),
-            stamp: vec![0; cells],
-            generation: 0,
+            touched: vec![0; cells.div_ceil(64)],
+            empty_cells: cells,
+            dirty: Vec::new(),
+            new_levels: Vec::new(),
+            changes: Vec::new(),
             rounds: 0,
             partition: None,
         }
@@ -243,12 +239,9 @@ impl ClusterSampler {
     /// Bytes held by the sampler's per-cell and per-pixel state.
     pub fn bytes(&self) -> usize {
         self.sums.bytes()
-            + (self.levels.capacity()
-                + self.feature_level.capacity()
-                + self.g.capacity()
-                + self.s.capacity())
-                * 4
-            + self.stamp.capacity() * 4
+            + self.levels.capacity() * 4
+            + self.squashed.capacity() * std::mem::size_of::<Squashed>()
+            + self.touched.capacity() * 8
             + self.pixel_count.capacity() * 4
             + self.clustering.as_ref().map_or(0, Clustering::bytes)
             + self.queue.bytes()
@@ -289,10 +282,8 @@ impl ClusterSampler {
     /// Ends the first stage: every cell's level and features, their scales, the clusters.
     fn cluster(&mut self) {
         let initial = initial_clustering(&self.grid, &self.sums, &self.settings.cluster_params());
-        self.feature_level = initial.levels.clone();
+        self.squashed = initial.squashed;
         self.levels = initial.levels;
-        self.g = initial.g;
-        self.s = initial.s;
         self.scale = Some(initial.scale);
         let clustering = initial.clustering;
         self.version = vec![0; clustering.clusters.len()];
@@ -345,9 +336,13 @@ impl ClusterSampler {
         for (priority, e) in deferred {
             self.queue.push(priority, e);
         }
-        let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
+        // Every planned sample is spent, whether or not it comes back valid.
+        let clustering = self.clustering.as_mut().expect("clustered");
+        for &(id, k) in &picks {
+            clustering.spend(id, k);
+        }
         if self.settings.even_pixels {
-            self.draw_pixels(&picks, &mut rng, out);
+            self.draw_pixels(&picks, out);
             let (init, grid) = (&self.init, &self.grid);
             let seed = init.seed();
             self.round_cells.resize(out.len(), (0, [0.0; MAX_DIMS]));
@@ -360,6 +355,7 @@ impl ClusterSampler {
                     *slot = (cell as u32, off);
                 });
         } else {
+            let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
             self.draw_cells(&picks, &mut rng, out);
         }
         self.round_clusters = picks.iter().map(|&(id, _)| id).collect();
@@ -378,33 +374,54 @@ impl ClusterSampler {
     /// Draws the round's pixels (evenpixels): each pick's samples go to pixels of its cells,
     /// and each gets the pixel's next index; `out` holds them sorted by row, the rest of each
     /// point left to be made.
-    fn draw_pixels(&mut self, picks: &[(u32, u64)], rng: &mut Pcg32, out: &mut Vec<SamplePoint>) {
+    fn draw_pixels(&mut self, picks: &[(u32, u64)], out: &mut Vec<SamplePoint>) {
         let clustering = self.clustering.as_ref().expect("clustered");
         let per_pixel = self.grid.cells_per_pixel();
         let width = self.space.width() as usize;
         let rows = self.space.height() as usize;
+        for &(id, _) in picks {
+            self.planned[id as usize] = 0;
+        }
+        // Each pick draws from its own stream, so that picks are drawn in parallel and the
+        // pixels do not depend on the thread count.
+        let round_key = mix64(self.seed ^ SALT ^ mix64(self.rounds));
+        let (grid, space) = (&self.grid, &self.space);
+        let pixel_index = |p: [u32; 2]| {
+            (p[1] - space.y0) as usize * space.width() as usize + (p[0] - space.x0) as usize
+        };
+        let groups: Vec<Vec<u32>> = picks
+            .par_chunks(PICKS_PER_TASK)
+            .enumerate()
+            .map(|(g, group)| {
+                let mut drawn = Vec::new();
+                for (n, &(id, k)) in group.iter().enumerate() {
+                    let stream = (g * PICKS_PER_TASK + n) as u64;
+                    let mut rng = Pcg32::new(round_key, stream);
+                    let cells = &clustering.clusters[id as usize].cells;
+                    for slot in Self::slots(&mut rng, cells.len(), k) {
+                        let cell = cells[slot] as usize;
+                        let pixel = match per_pixel {
+                            Some(per) => grid.pixel_of_cell(cell, per),
+                            None => {
+                                let mut u = [0.5f32; MAX_DIMS];
+                                u[0] = rng.next_f32();
+                                u[1] = rng.next_f32();
+                                grid.pixel(cell, &u)
+                            }
+                        };
+                        drawn.push(pixel_index(pixel) as u32);
+                    }
+                }
+                drawn
+            })
+            .collect();
         let mut drawn = std::mem::take(&mut self.drawn);
         drawn.clear();
         let mut start = vec![0usize; rows + 1];
-        for &(id, k) in picks {
-            self.planned[id as usize] = 0;
-            let cells = &clustering.clusters[id as usize].cells;
-            for slot in Self::slots(rng, cells.len(), k) {
-                let cell = cells[slot] as usize;
-                let pixel = match per_pixel {
-                    Some(per) => self.grid.pixel_of_cell(cell, per),
-                    None => {
-                        let mut u = [0.5f32; MAX_DIMS];
-                        u[0] = rng.next_f32();
-                        u[1] = rng.next_f32();
-                        self.grid.pixel(cell, &u)
-                    }
-                };
-                let p = self.pixel_index(pixel);
-                drawn.push(p as u32);
-                start[p / width + 1] += 1;
-            }
+        for p in groups.iter().flatten() {
+            start[*p as usize / width + 1] += 1;
         }
+        drawn.extend(groups.into_iter().flatten());
         // The film takes samples sorted by row: a stable counting sort, O(n). A pixel's
         // indices follow the draw order, as the sort is stable.
         for r in 0..rows {
@@ -483,89 +500,76 @@ impl ClusterSampler {
     /// Table 1's UpdateCluster after a round: new levels and features for the cells that got
     /// samples and their face neighbours, then the cells that no longer fit move.
     fn update(&mut self) {
-        self.generation += 1;
-        let gen = self.generation;
         // The cells that got samples get new features; their neighbours' levels follow where
         // those are filled in from them (no samples of their own), but their features wait
         // until they are sampled: recomputing them too (table 1) cost 5 to 11 times as much
         // (one feature per face neighbour) for features that move by one cell's share.
-        let mut dirty: Vec<u32> = Vec::with_capacity(self.touched.len());
-        for &c in &self.touched {
-            if self.stamp[c as usize] != gen {
-                self.stamp[c as usize] = gen;
-                dirty.push(c);
+        let mut dirty = std::mem::take(&mut self.dirty);
+        dirty.clear();
+        for (w, bits) in self.touched.iter_mut().enumerate() {
+            while *bits != 0 {
+                dirty.push((w * 64) as u32 + bits.trailing_zeros());
+                *bits &= *bits - 1;
             }
         }
-        self.touched.clear();
-        dirty.sort_unstable();
         let (grid, sums) = (&self.grid, &self.sums);
-        let mut empty: Vec<u32> = dirty
-            .par_iter()
-            .flat_map_iter(|&c| {
-                let mut nbrs = Vec::with_capacity(2 * MAX_DIMS);
-                grid.neighbours(c as usize, &mut nbrs);
-                nbrs.retain(|&j| sums.count[j] == 0);
-                nbrs.into_iter().map(|j| j as u32)
-            })
-            .collect();
-        empty.par_sort_unstable();
-        empty.dedup();
-        let new_levels: Vec<f32> = dirty
+        let mut empty: Vec<u32> = Vec::new();
+        if self.empty_cells > 0 {
+            empty = dirty
+                .par_iter()
+                .flat_map_iter(|&c| {
+                    let mut nbrs = Vec::with_capacity(2 * MAX_DIMS);
+                    grid.neighbours(c as usize, &mut nbrs);
+                    nbrs.retain(|&j| sums.count[j] == 0);
+                    nbrs.into_iter().map(|j| j as u32)
+                })
+                .collect();
+            empty.par_sort_unstable();
+            empty.dedup();
+            self.empty_cells = sums.count.par_iter().filter(|&&n| n == 0).count();
+        }
+        let mut new_levels = std::mem::take(&mut self.new_levels);
+        dirty
             .par_iter()
             .chain(empty.par_iter())
             .map(|&i| level(grid, sums, i as usize))
-            .collect();
-        for (&i, l) in dirty.iter().chain(&empty).zip(new_levels) {
+            .collect_into_vec(&mut new_levels);
+        for (&i, &l) in dirty.iter().chain(&empty).zip(&new_levels) {
             self.levels[i as usize] = l;
         }
+        self.new_levels = new_levels;
         let mut nbrs = Vec::new();
         let (grid, sums) = (&self.grid, &self.sums);
         let levels = &self.levels;
         let scale = self.scale.expect("clustered");
         let n = grid.dims();
-        let (g_old, s_old, level_old) = (&self.g, &self.s, &self.feature_level);
+        let squashed = &self.squashed;
         // New raw features, and the old and new feature vectors of the cells whose features changed,
         // made in parallel: the moves below are the only serial part.
-        let changes: Vec<Option<FeatureChange>> = dirty
-            .par_iter()
-            .map(|&i| {
-                let i = i as usize;
-                let (g, s) = raw(grid, sums, levels, i);
-                let level = levels[i];
-                if g == g_old[i] && s == s_old[i] && level == level_old[i] {
-                    return None;
-                }
-                let c = grid.coords(i);
-                let old = scale.feature(n, &c, g_old[i], s_old[i], level_old[i]);
-                let new = scale.feature(n, &c, g, s, level);
-                Some(FeatureChange {
-                    cell: i as u32,
-                    g,
-                    s,
-                    old,
-                    new,
-                })
-            })
-            .collect();
+        let mut changes = std::mem::take(&mut self.changes);
+        changes.clear();
+        changes.par_extend(dirty.par_iter().filter_map(|&i| {
+            let i = i as usize;
+            let (g, s) = raw(grid, sums, levels, i);
+            let q = scale.squash(g, s, levels[i]);
+            (q != squashed[i]).then_some((i as u32, q))
+        }));
         let clustering = self.clustering.as_mut().expect("clustered");
         let mut changed: Vec<u32> = std::mem::take(&mut self.round_clusters);
-        for FeatureChange {
-            cell,
-            g,
-            s,
-            old,
-            new,
-        } in changes.into_iter().flatten()
-        {
+        for &(cell, q) in &changes {
             let i = cell as usize;
-            self.g[i] = g;
-            self.s[i] = s;
-            self.feature_level[i] = self.levels[i];
+            let c = grid.coords(i);
+            let (old, new) = (
+                scale.feature_of(n, &c, self.squashed[i]),
+                scale.feature_of(n, &c, q),
+            );
+            self.squashed[i] = q;
             let (a, b) =
                 clustering.update(grid, i, &old, &new, u64::from(sums.count[i]), &mut nbrs);
             changed.push(a);
             changed.extend(b);
         }
+        (self.dirty, self.changes) = (dirty, changes);
         let live = clustering.live();
         if self.version.len() < clustering.clusters.len() {
             self.version.resize(clustering.clusters.len(), 0);
@@ -685,25 +689,27 @@ impl Sampler for ClusterSampler {
     }
 
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        // An adaptive point's cell is known from when it was made; the first stage's are
+        // found here, in parallel.
         let adaptive = self.phase == Phase::Adaptive && self.round_cells.len() == batch.len();
-        for (k, (q, l)) in batch.iter().zip(radiance).enumerate() {
-            // An adaptive point's cell is known from when it was made.
-            let (cell, off) = if adaptive {
-                let (c, u) = self.round_cells[k];
-                (c as usize, u)
-            } else {
-                self.grid.locate(q)
-            };
-            if let Some(k) = self.clustering.as_mut() {
-                k.spend(cell, 1);
-            }
-            // NaN marks a dropped sample: it was spent but tells nothing.
-            if l[0].is_nan() {
-                continue;
-            }
-            self.sums.add(cell, &off, Spectrum::from_array(*l));
-            if adaptive {
-                self.touched.push(cell as u32);
+        if !adaptive {
+            let grid = &self.grid;
+            batch
+                .par_iter()
+                .with_min_len(256)
+                .map(|q| {
+                    let (cell, off) = grid.locate(q);
+                    (cell as u32, off)
+                })
+                .collect_into_vec(&mut self.round_cells);
+        }
+        // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
+        self.sums.add_batch(&self.round_cells, radiance);
+        if adaptive {
+            for (&(cell, _), l) in self.round_cells.iter().zip(radiance) {
+                if !l[0].is_nan() {
+                    self.touched[cell as usize / 64] |= 1 << (cell % 64);
+                }
             }
         }
         if self.phase == Phase::Adaptive {
@@ -1044,7 +1050,7 @@ mod tests {
         let kept: u64 = sums.count.iter().map(|&c| u64::from(c)).sum();
         assert!(kept > 0 && kept < pts.len() as u64);
         assert!(sums.lum.iter().all(|v| v.is_finite()));
-        assert!(s.g.iter().chain(&s.s).all(|v| v.is_finite()));
+        assert!(s.squashed.iter().flatten().all(|v| v.is_finite()));
     }
 
     #[test]

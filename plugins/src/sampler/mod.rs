@@ -26,6 +26,7 @@ use crate::registry::{Choice, Entry};
 pub(crate) use crate::rng::{mix64, Pcg32};
 use crate::space::{RenderingSpace, SamplePoint};
 use acr_parser::{Error, ParamList, ParamType, Result};
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Samples per batch: enough to keep every thread busy, few enough to report progress often.
@@ -233,10 +234,13 @@ impl PixelCursor {
     }
 }
 
+/// Pixels whose points one task makes: enough to outweigh the task's cost.
+const PIXELS_PER_TASK: usize = 64;
+
 /// A sampler whose points in a pixel depend only on the pixel, the sample index and the seed.
 /// It walks the image with a [`PixelCursor`]; the walk, the budget and halting are the same for
 /// every such sampler, so implementing this trait gives [`Sampler`].
-pub(crate) trait PixelPattern: Send {
+pub(crate) trait PixelPattern: Send + Sync {
     /// The plugin's name.
     const NAME: &'static str;
 
@@ -265,9 +269,27 @@ impl<T: PixelPattern> Sampler for T {
             return false;
         };
         let space = *self.cursor().space();
-        for i in pixels {
-            self.pixel(space.pixel(i), indices.clone(), out);
-        }
+        // Pixels' points are independent: made in parallel, each pixel's into its place.
+        let this = &*self;
+        let per_pixel = indices.len();
+        let blank = SamplePoint {
+            pixel: [0; 2],
+            index: 0,
+            film: [0.0; 2],
+            time: 0.5,
+            lens: [0.5; 2],
+        };
+        out.resize((pixels.end - pixels.start) as usize * per_pixel, blank);
+        out.par_chunks_mut(PIXELS_PER_TASK * per_pixel)
+            .enumerate()
+            .for_each_init(Vec::new, |points, (task, chunk)| {
+                let first = pixels.start + (task * PIXELS_PER_TASK) as u64;
+                for (k, slot) in chunk.chunks_mut(per_pixel).enumerate() {
+                    points.clear();
+                    this.pixel(space.pixel(first + k as u64), indices.clone(), points);
+                    slot.copy_from_slice(points);
+                }
+            });
         true
     }
 
