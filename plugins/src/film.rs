@@ -9,7 +9,6 @@ use crate::filters::FilterKernel;
 use crate::space::SamplePoint;
 use acr_parser::{Error, PluginDesc, Result};
 use glam::{Vec2, Vec3};
-use rayon::prelude::*;
 
 /// Linear RGB radiance.
 pub type Spectrum = Vec3;
@@ -404,15 +403,7 @@ impl Film {
         let Some((grid, sums)) = self.cells.as_mut() else {
             return;
         };
-        let grid = &*grid;
-        batch
-            .par_iter()
-            .with_min_len(256)
-            .map(|q| {
-                let (cell, off) = grid.locate(q);
-                (cell as u32, off)
-            })
-            .collect_into_vec(&mut self.located);
+        grid.locate_all(batch, &mut self.located);
         sums.add_batch(&self.located, radiance);
     }
 

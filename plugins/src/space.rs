@@ -72,6 +72,12 @@ impl RenderingSpace {
         u64::from(self.width()) * u64::from(self.height())
     }
 
+    /// The row-major index of pixel `p` (which must lie in the space): [`Self::pixel`]'s inverse.
+    #[inline]
+    pub fn index_of(&self, p: [u32; 2]) -> usize {
+        (p[1] - self.y0) as usize * self.width() as usize + (p[0] - self.x0) as usize
+    }
+
     /// The `i`-th pixel in row-major order, as `[x, y]`.
     #[inline]
     pub fn pixel(&self, i: u64) -> [u32; 2] {
@@ -95,6 +101,18 @@ pub struct SamplePoint {
     pub time: f32,
     /// Lens position in [0, 1)^2; `[0.5, 0.5]` when the lens dims are inactive.
     pub lens: [f32; 2],
+}
+
+impl SamplePoint {
+    /// A point not made yet: pixel 0, index 0, inactive time and lens; what a buffer is
+    /// filled with before its points are written in place.
+    pub const UNMADE: Self = Self {
+        pixel: [0; 2],
+        index: 0,
+        film: [0.0; 2],
+        time: 0.5,
+        lens: [0.5; 2],
+    };
 }
 
 /// The largest f32 below 1, so that a value meant to lie in [0, 1) never rounds up to 1.

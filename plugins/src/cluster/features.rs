@@ -306,11 +306,8 @@ mod tests {
     fn the_interior_shortcut_gives_the_same_gradient_bit_for_bit() {
         // Every combination of active dims and bins 1 (dims of one cell), 2 (no shortcut)
         // and 3, over random levels.
-        let mut state = 7u64;
-        let mut next = || {
-            state = crate::rng::mix64(state);
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::rng::Pcg32::new(7, 0);
+        let mut next = || rng.next_f32();
         let mut checked = 0;
         for (time, lens) in [(false, false), (true, false), (false, true), (true, true)] {
             for bins in [1, 2, 3] {

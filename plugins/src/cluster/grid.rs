@@ -225,6 +225,18 @@ impl CellGrid {
         (self.index(&c), off)
     }
 
+    /// [`Self::locate`] for every point of `batch`, in parallel, into `out` (cell, offsets).
+    pub fn locate_all(&self, batch: &[SamplePoint], out: &mut Vec<(u32, [f32; MAX_DIMS])>) {
+        batch
+            .par_iter()
+            .with_min_len(256)
+            .map(|q| {
+                let (cell, off) = self.locate(q);
+                (cell as u32, off)
+            })
+            .collect_into_vec(out);
+    }
+
     /// [`Self::locate`] when cells are whole pixels with one interval along every other dim:
     /// the same arithmetic without the divisions by a unit of 1.
     #[inline]
@@ -446,28 +458,22 @@ impl CellSums {
                 members[*cell as usize / band_len].push(k as u32);
             }
         }
-        let add_band = |(start, mut band, members): (usize, Band<'_>, &Vec<u32>)| {
+        let add_band = |b: usize, mut band: Band<'_>, members: &[u32]| {
             for &k in members {
                 let (cell, off) = &located[k as usize];
-                band.add(
-                    *cell as usize - start,
-                    off,
-                    Spectrum::from_array(radiance[k as usize]),
-                );
+                let i = *cell as usize - b * band_len;
+                band.add(i, off, Spectrum::from_array(radiance[k as usize]));
             }
         };
         if bands == 1 {
-            add_band((0, self.band(0, cells), &members[0]));
+            add_band(0, self.band(0, cells), &members[0]);
             return;
         }
-        let starts: Vec<usize> = (0..bands).map(|b| b * band_len).collect();
-        let views: Vec<Band<'_>> = self.bands(band_len);
-        starts
+        self.bands(band_len)
             .into_par_iter()
-            .zip(views)
             .zip(&members)
-            .map(|((s, b), m)| (s, b, m))
-            .for_each(add_band);
+            .enumerate()
+            .for_each(|(b, (band, members))| add_band(b, band, members));
     }
 
     /// The sums of cells `start..end` as one band.
@@ -596,11 +602,8 @@ mod tests {
 
     #[test]
     fn pixel_cells_locate_as_the_general_rule_does() {
-        let mut state = 3u64;
-        let mut next = || {
-            state = crate::rng::mix64(state);
-            (state >> 40) as f64 / (1u64 << 24) as f64
-        };
+        let mut rng = crate::rng::Pcg32::new(3, 0);
+        let mut next = || f64::from(rng.next_f32());
         for (time, lens) in [(false, false), (true, false), (true, true)] {
             let g = CellGrid::new(space(7, 5, time, lens), 1.0, 1);
             assert!(g.pixel_cells);

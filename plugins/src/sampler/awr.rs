@@ -177,7 +177,7 @@ impl PixelMethod for Awr {
         (0..w * h)
             .map(|i| {
                 let c = approx[(i / w) * side + i % w].c;
-                Spectrum::new(c[0] as f32, c[1] as f32, c[2] as f32).max(Spectrum::ZERO)
+                super::nonnegative_spectrum([c[0], c[1], c[2]])
             })
             .collect()
     }

@@ -247,13 +247,6 @@ impl ClusterSampler {
             + self.queue.bytes()
     }
 
-    /// The index of pixel `p` in `pixel_count`.
-    #[inline]
-    fn pixel_index(&self, p: [u32; 2]) -> usize {
-        (p[1] - self.space.y0) as usize * self.space.width() as usize
-            + (p[0] - self.space.x0) as usize
-    }
-
     /// The sampling priority of `c` with `extra` samples planned on top of its own.
     fn priority(&self, c: &Cluster, extra: u64) -> f64 {
         let tolerance = self.clustering.as_ref().map_or(0.0, |k| k.rule.tolerance);
@@ -386,9 +379,6 @@ impl ClusterSampler {
         // pixels do not depend on the thread count.
         let round_key = mix64(self.seed ^ SALT ^ mix64(self.rounds));
         let (grid, space) = (&self.grid, &self.space);
-        let pixel_index = |p: [u32; 2]| {
-            (p[1] - space.y0) as usize * space.width() as usize + (p[0] - space.x0) as usize
-        };
         let groups: Vec<Vec<u32>> = picks
             .par_chunks(PICKS_PER_TASK)
             .enumerate()
@@ -409,7 +399,7 @@ impl ClusterSampler {
                                 grid.pixel(cell, &u)
                             }
                         };
-                        drawn.push(pixel_index(pixel) as u32);
+                        drawn.push(space.index_of(pixel) as u32);
                     }
                 }
                 drawn
@@ -417,25 +407,18 @@ impl ClusterSampler {
             .collect();
         let mut drawn = std::mem::take(&mut self.drawn);
         drawn.clear();
-        let mut start = vec![0usize; rows + 1];
-        for p in groups.iter().flatten() {
-            start[*p as usize / width + 1] += 1;
-        }
         drawn.extend(groups.into_iter().flatten());
+        let mut start = vec![0usize; rows + 1];
+        for &p in &drawn {
+            start[p as usize / width + 1] += 1;
+        }
         // The film takes samples sorted by row: a stable counting sort, O(n). A pixel's
         // indices follow the draw order, as the sort is stable.
         for r in 0..rows {
             start[r + 1] += start[r];
         }
-        let blank = SamplePoint {
-            pixel: [0; 2],
-            index: 0,
-            film: [0.0; 2],
-            time: 0.5,
-            lens: [0.5; 2],
-        };
         out.clear();
-        out.resize(drawn.len(), blank);
+        out.resize(drawn.len(), SamplePoint::UNMADE);
         let (x0, y0) = (self.space.x0, self.space.y0);
         for &p in &drawn {
             let p = p as usize;
@@ -444,7 +427,7 @@ impl ClusterSampler {
             out[*r] = SamplePoint {
                 pixel: [x0 + (p % width) as u32, y0 + (p / width) as u32],
                 index: *index,
-                ..blank
+                ..SamplePoint::UNMADE
             };
             *index += 1;
             *r += 1;
@@ -468,7 +451,7 @@ impl ClusterSampler {
                 }
                 let cell = cells[slot];
                 let mut q = self.grid.point(cell as usize, &u);
-                let p = self.pixel_index(q.pixel);
+                let p = self.space.index_of(q.pixel);
                 q.index = self.pixel_count[p];
                 self.pixel_count[p] += 1;
                 points.push((q, cell, u));
@@ -662,7 +645,7 @@ impl Sampler for ClusterSampler {
         if self.phase == Phase::Init {
             if self.init.next_batch(out) {
                 for q in out.iter() {
-                    let p = self.pixel_index(q.pixel);
+                    let p = self.space.index_of(q.pixel);
                     self.pixel_count[p] += 1;
                 }
                 return true;
@@ -693,15 +676,7 @@ impl Sampler for ClusterSampler {
         // found here, in parallel.
         let adaptive = self.phase == Phase::Adaptive && self.round_cells.len() == batch.len();
         if !adaptive {
-            let grid = &self.grid;
-            batch
-                .par_iter()
-                .with_min_len(256)
-                .map(|q| {
-                    let (cell, off) = grid.locate(q);
-                    (cell as u32, off)
-                })
-                .collect_into_vec(&mut self.round_cells);
+            self.grid.locate_all(batch, &mut self.round_cells);
         }
         // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
         self.sums.add_batch(&self.round_cells, radiance);

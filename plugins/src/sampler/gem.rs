@@ -156,9 +156,7 @@ impl PixelMethod for Gem {
     fn reconstruct(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<Spectrum> {
         self.select(space, m)
             .into_iter()
-            .map(|(v, _, _)| {
-                Spectrum::new(v[0] as f32, v[1] as f32, v[2] as f32).max(Spectrum::ZERO)
-            })
+            .map(|(v, _, _)| super::nonnegative_spectrum(v))
             .collect()
     }
 }

@@ -365,10 +365,8 @@ impl MdasSampler {
     fn queue(&mut self, ats: Vec<[f32; MAX_DIMS]>) {
         let mut points: Vec<SamplePoint> = ats.iter().map(|at| self.point(at)).collect();
         points.sort_by_key(|q| (q.pixel[1], q.pixel[0]));
-        let w = self.space.width() as usize;
         for q in &mut points {
-            let i =
-                (q.pixel[1] - self.space.y0) as usize * w + (q.pixel[0] - self.space.x0) as usize;
+            let i = self.space.index_of(q.pixel);
             q.index = self.per_pixel[i];
             self.per_pixel[i] += 1;
         }
@@ -526,12 +524,7 @@ impl Sampler for MdasSampler {
                 }
             }
         }
-        Some(
-            image
-                .into_iter()
-                .map(|v| Spectrum::new(v[0] as f32, v[1] as f32, v[2] as f32).max(Spectrum::ZERO))
-                .collect(),
-        )
+        Some(image.into_iter().map(super::nonnegative_spectrum).collect())
     }
 }
 

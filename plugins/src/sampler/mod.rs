@@ -272,14 +272,10 @@ impl<T: PixelPattern> Sampler for T {
         // Pixels' points are independent: made in parallel, each pixel's into its place.
         let this = &*self;
         let per_pixel = indices.len();
-        let blank = SamplePoint {
-            pixel: [0; 2],
-            index: 0,
-            film: [0.0; 2],
-            time: 0.5,
-            lens: [0.5; 2],
-        };
-        out.resize((pixels.end - pixels.start) as usize * per_pixel, blank);
+        out.resize(
+            (pixels.end - pixels.start) as usize * per_pixel,
+            SamplePoint::UNMADE,
+        );
         out.par_chunks_mut(PIXELS_PER_TASK * per_pixel)
             .enumerate()
             .for_each_init(Vec::new, |points, (task, chunk)| {
@@ -296,6 +292,12 @@ impl<T: PixelPattern> Sampler for T {
     fn halt(&mut self) {
         self.cursor_mut().halt();
     }
+}
+
+/// An estimate in f64, as a pixel's radiance: never negative (the image-space samplers'
+/// reconstructions can undershoot).
+pub(crate) fn nonnegative_spectrum(c: [f64; 3]) -> Spectrum {
+    Spectrum::new(c[0] as f32, c[1] as f32, c[2] as f32).max(Spectrum::ZERO)
 }
 
 /// A key for `pixel` under `seed`, salted per sampler so that samplers do not share streams

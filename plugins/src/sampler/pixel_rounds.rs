@@ -271,13 +271,11 @@ impl<M: PixelMethod> Sampler for PixelRounds<M> {
     }
 
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
-        let w = self.space.width() as usize;
         for (q, l) in batch.iter().zip(radiance) {
             if !l.iter().all(|v| v.is_finite()) {
                 continue;
             }
-            let i =
-                (q.pixel[1] - self.space.y0) as usize * w + (q.pixel[0] - self.space.x0) as usize;
+            let i = self.space.index_of(q.pixel);
             let m = &mut self.moments;
             m.count[i] += 1;
             for c in 0..3 {
