@@ -264,6 +264,7 @@ fn sampler(name: &str, dims: Dims) -> Box<dyn Sampler> {
         space: space(dims),
         spp: Some(SPP),
         seed: 1,
+        reconstruction_reads_cells: false,
     };
     (entry.build)(&Choice::new(None, name, None), &setup).expect("sampler")
 }

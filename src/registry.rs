@@ -107,7 +107,8 @@ fn resolve<'a, B>(
 
 /// Chooses and builds the sampler, filter and integrator: the scene's directives, with the
 /// command line's names and settings on top. Without a directive, pbrt-v3's defaults: the
-/// `halton` sampler at 16 spp, the `box` filter and the `path` integrator.
+/// `halton` sampler at 16 spp, the `box` filter and the `path` integrator. The sampler's
+/// setup says whether the chosen filter reads its cells.
 pub fn choose(
     desc: &SceneDescription,
     overrides: &Overrides,
@@ -133,7 +134,11 @@ pub fn choose(
         overrides.sampler.as_deref(),
     );
     let se: &Entry<SamplerBuild> = resolve(SAMPLERS, Kind::Sampler, &mut sc, overrides, warnings)?;
-    let sampler = (se.build)(&sc, &setup())?;
+    let setup = SamplerSetup {
+        reconstruction_reads_cells: filter.cell_layout().is_some(),
+        ..setup()
+    };
+    let sampler = (se.build)(&sc, &setup)?;
     if sampler.reconstructs() {
         // The method's reconstruction is part of it: a filter asked for is not used.
         let named = overrides
@@ -183,6 +188,8 @@ pub fn choose_for_scene(
         space: crate::render::rendering_space(scene),
         spp,
         seed,
+        // `choose` sets it from the filter it chooses.
+        reconstruction_reads_cells: false,
     };
     choose(desc, overrides, setup, warnings)
 }

@@ -460,3 +460,42 @@ fn converged_render_is_closer_to_pbrt_v3_than_its_own_8_spp() {
         "{scene}: MSE {mse:.3e} at 32 spp is not below half of pbrt-v3's {pbrt_mse_8spp:.1e} at 8 spp"
     );
 }
+
+#[test]
+fn the_cluster_sampler_sums_radiance_in_its_cells_only_for_a_filter_that_reads_them() {
+    let mut desc = parse_file(&root().join("scenes/motion-dof.pbrt")).unwrap();
+    set_resolution(&mut desc, 24, 16);
+    let mut warnings = Vec::new();
+    let scene = Scene::build(&desc, &mut warnings).unwrap();
+    for (filter, reads) in [("gaussian", false), ("box", false), ("polynomial", true)] {
+        let overrides = Overrides {
+            sampler: Some("cluster".into()),
+            filter: Some(filter.into()),
+            ..Default::default()
+        };
+        let mut plugins =
+            choose_for_scene(&desc, &scene, &overrides, Some(4), 1, &mut warnings).unwrap();
+        assert_eq!(plugins.sampler.keeps_cells(), reads, "{filter}");
+        let mut film = plugins.film(&scene);
+        let sampler = plugins.sampler.as_mut();
+        render(
+            &scene,
+            &plugins.integrator,
+            sampler,
+            &mut film,
+            1,
+            None,
+            None,
+        );
+        let kept = plugins.sampler.cells().map(|c| c.sums.keeps_radiance());
+        assert_eq!(kept, reads.then_some(true), "{filter}");
+        let image = plugins.image(&film);
+        assert!(image
+            .iter()
+            .all(|p| p.is_finite() && p.min_element() >= 0.0));
+        assert!(
+            image.iter().any(|p| p.max_element() > 0.0),
+            "{filter}: a black image"
+        );
+    }
+}

@@ -100,14 +100,22 @@ impl CellGrid {
     /// The coordinates of cell `i`.
     #[inline]
     pub fn coords(&self, i: usize) -> Coords {
+        // In u32 (cell ids are u32 throughout), and no division for dims of one cell: this
+        // runs for every cell a round touches, and 64-bit divisions dominated it.
         let mut c = [0; MAX_DIMS];
-        let image = i / self.stride[0];
-        c[0] = (image % self.shape[0] as usize) as u32;
-        c[1] = (image / self.shape[0] as usize) as u32;
-        let mut inner = i % self.stride[0];
+        let (i, inner_len, width) = (i as u32, self.stride[0] as u32, self.shape[0]);
+        let (image, mut inner) = if inner_len == 1 {
+            (i, 0)
+        } else {
+            (i / inner_len, i % inner_len)
+        };
+        c[0] = image % width;
+        c[1] = image / width;
         for (cd, &len) in c[2..self.n].iter_mut().zip(&self.shape[2..self.n]) {
-            *cd = (inner % len as usize) as u32;
-            inner /= len as usize;
+            if len > 1 {
+                *cd = inner % len;
+                inner /= len;
+            }
         }
         c
     }
@@ -339,12 +347,15 @@ impl CellGrid {
     /// [`Self::cells_per_pixel`]).
     #[inline]
     pub fn pixel_of_cell(&self, i: usize, per_pixel: u32) -> [u32; 2] {
+        let (x0, y0) = (self.space.x0, self.space.y0);
+        if self.pixel_cells {
+            // Cell i is pixel i: one division (this runs once per adaptive sample).
+            let (i, w) = (i as u32, self.shape[0]);
+            return [x0 + i % w, y0 + i / w];
+        }
         let image = (i / self.stride[0]) as u32;
         let (cx, cy) = (image % self.shape[0], image / self.shape[0]);
-        [
-            self.space.x0 + cx / per_pixel,
-            self.space.y0 + cy / per_pixel,
-        ]
+        [x0 + cx / per_pixel, y0 + cy / per_pixel]
     }
 
     /// The image cell (x, y cell coordinates) holding the centre of pixel `(px, py)`, given
@@ -380,6 +391,10 @@ impl Band<'_> {
         let y = f64::from(luminance(l));
         self.lum[i] += y;
         self.lum_sq[i] += y * y;
+        if self.rgb.is_empty() {
+            // Luminance-only sums ([`CellSums::luminance_only`]).
+            return;
+        }
         for (c, v) in [l.x, l.y, l.z].into_iter().enumerate() {
             self.rgb[i][c] += v;
             self.rgb_sq[i][c] += v * v;
@@ -422,15 +437,35 @@ impl CellSums {
     pub fn new(grid: &CellGrid) -> Self {
         let n = grid.len();
         Self {
-            count: vec![0; n],
             rgb: vec![[0.0; 3]; n],
             rgb_sq: vec![[0.0; 3]; n],
-            lum: vec![0.0; n],
-            lum_sq: vec![0.0; n],
             offset: vec![0.0; n * grid.dims()],
             offset_sq: vec![0.0; n * grid.dims()],
+            ..Self::luminance_only(grid)
+        }
+    }
+
+    /// Zeroed sums of count and luminance only, for when nothing reads the cells' radiance
+    /// and positions (the cluster sampler's features need neither): `rgb`, `rgb_sq`,
+    /// `offset` and `offset_sq` stay empty, and adding a sample touches three arrays, not
+    /// seven.
+    pub fn luminance_only(grid: &CellGrid) -> Self {
+        let n = grid.len();
+        Self {
+            count: vec![0; n],
+            rgb: Vec::new(),
+            rgb_sq: Vec::new(),
+            lum: vec![0.0; n],
+            lum_sq: vec![0.0; n],
+            offset: Vec::new(),
+            offset_sq: Vec::new(),
             dims: grid.dims(),
         }
+    }
+
+    /// Whether the sums hold radiance and positions, not only luminance.
+    pub fn keeps_radiance(&self) -> bool {
+        !self.rgb.is_empty() || self.count.is_empty()
     }
 
     /// Adds one sample of radiance `l` at offsets `off` to cell `i`.
@@ -479,14 +514,20 @@ impl CellSums {
     /// The sums of cells `start..end` as one band.
     fn band(&mut self, start: usize, end: usize) -> Band<'_> {
         let d = self.dims;
+        // Luminance-only sums have empty radiance arrays: their bands' are empty too.
+        let (r, o) = if self.rgb.is_empty() {
+            (0..0, 0..0)
+        } else {
+            (start..end, start * d..end * d)
+        };
         Band {
             count: &mut self.count[start..end],
-            rgb: &mut self.rgb[start..end],
-            rgb_sq: &mut self.rgb_sq[start..end],
+            rgb: &mut self.rgb[r.clone()],
+            rgb_sq: &mut self.rgb_sq[r],
             lum: &mut self.lum[start..end],
             lum_sq: &mut self.lum_sq[start..end],
-            offset: &mut self.offset[start * d..end * d],
-            offset_sq: &mut self.offset_sq[start * d..end * d],
+            offset: &mut self.offset[o.clone()],
+            offset_sq: &mut self.offset_sq[o],
             dims: d,
         }
     }
@@ -494,14 +535,19 @@ impl CellSums {
     /// The sums split into bands of `band_len` cells, in order.
     fn bands(&mut self, band_len: usize) -> Vec<Band<'_>> {
         let d = self.dims;
+        // Chunks of an array, then empty ones: luminance-only sums' radiance arrays are empty.
+        fn chunks<T>(v: &mut [T], len: usize) -> impl Iterator<Item = &mut [T]> {
+            v.chunks_mut(len)
+                .chain(std::iter::repeat_with(|| &mut [][..]))
+        }
         self.count
             .chunks_mut(band_len)
-            .zip(self.rgb.chunks_mut(band_len))
-            .zip(self.rgb_sq.chunks_mut(band_len))
+            .zip(chunks(&mut self.rgb, band_len))
+            .zip(chunks(&mut self.rgb_sq, band_len))
             .zip(self.lum.chunks_mut(band_len))
             .zip(self.lum_sq.chunks_mut(band_len))
-            .zip(self.offset.chunks_mut(band_len * d))
-            .zip(self.offset_sq.chunks_mut(band_len * d))
+            .zip(chunks(&mut self.offset, band_len * d))
+            .zip(chunks(&mut self.offset_sq, band_len * d))
             .map(
                 |((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq)| Band {
                     count,
@@ -574,6 +620,15 @@ mod tests {
         for i in 0..g.len() {
             assert_eq!(g.index(&g.coords(i)), i);
         }
+        // Dims of one interval (bins 1) and of two, and half-pixel cells.
+        for (cs, bins) in [(1.0, 1), (1.0, 2), (0.5, 1)] {
+            let g = CellGrid::new(space(7, 5, true, true), cs, bins);
+            for i in 0..g.len() {
+                let c = g.coords(i);
+                assert_eq!(g.index(&c), i);
+                assert!((0..5).all(|d| c[d] < g.shape()[d]));
+            }
+        }
         // A pixel's cells are consecutive.
         assert_eq!(g.coords(26)[..2], [0, 0]);
         assert_eq!(g.coords(27)[..2], [1, 0]);
@@ -630,12 +685,15 @@ mod tests {
             (1.5, None),
             (0.75, None),
         ] {
-            let g = CellGrid::new(space(6, 4, true, false), cs, 2);
-            assert_eq!(g.cells_per_pixel(), per, "cellsize {cs}");
-            let Some(per) = per else { continue };
-            for i in 0..g.len() {
-                for u in [[0.0; MAX_DIMS], [0.999; MAX_DIMS]] {
-                    assert_eq!(g.pixel_of_cell(i, per), g.pixel(i, &u), "cell {i}");
+            // Cells cut in time, and whole-pixel cells (the shortcut) when cellsize is 1.
+            for (time, bins) in [(true, 2), (false, 1)] {
+                let g = CellGrid::new(space(6, 4, time, false), cs, bins);
+                assert_eq!(g.cells_per_pixel(), per, "cellsize {cs}");
+                let Some(per) = per else { continue };
+                for i in 0..g.len() {
+                    for u in [[0.0; MAX_DIMS], [0.999; MAX_DIMS]] {
+                        assert_eq!(g.pixel_of_cell(i, per), g.pixel(i, &u), "cell {i}");
+                    }
                 }
             }
         }
@@ -652,6 +710,43 @@ mod tests {
         let mid = g.index(&[1, 0, 1, 0, 0]);
         g.neighbours(mid, &mut v);
         assert_eq!(v.len(), 5);
+    }
+
+    #[test]
+    fn luminance_only_sums_agree_with_full_ones() {
+        let g = CellGrid::new(space(40, 30, true, true), 1.0, 2);
+        let mut rng = crate::rng::Pcg32::new(5, 1);
+        // More samples than PARALLEL_BATCH, so that the bands are summed in parallel.
+        let n = 3 * PARALLEL_BATCH;
+        let located: Vec<(u32, [f32; MAX_DIMS])> = (0..n)
+            .map(|_| {
+                let cell = (rng.next_f32() * g.len() as f32) as u32 % g.len() as u32;
+                (cell, [rng.next_f32(); MAX_DIMS])
+            })
+            .collect();
+        let radiance: Vec<[f32; 3]> = (0..n)
+            .map(|k| {
+                let v = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
+                // A dropped sample now and then.
+                if k % 97 == 0 {
+                    [f32::NAN; 3]
+                } else {
+                    v
+                }
+            })
+            .collect();
+        let (mut full, mut lum) = (CellSums::new(&g), CellSums::luminance_only(&g));
+        full.add_batch(&located, &radiance);
+        lum.add_batch(&located, &radiance);
+        assert!(full.keeps_radiance() && !lum.keeps_radiance());
+        assert_eq!(full.count, lum.count);
+        assert_eq!(full.lum, lum.lum);
+        assert_eq!(full.lum_sq, lum.lum_sq);
+        assert!(lum.rgb.is_empty() && lum.offset.is_empty() && lum.offset_sq.is_empty());
+        assert_eq!(full.count.iter().sum::<u32>(), (n - n.div_ceil(97)) as u32);
+        // 20 bytes a cell rather than 20 + 24 + 8 per active dim.
+        assert_eq!(lum.bytes(), 20 * g.len());
+        assert!(lum.bytes() * 3 < full.bytes());
     }
 
     #[test]

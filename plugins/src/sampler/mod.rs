@@ -113,6 +113,9 @@ pub struct SamplerSetup {
     pub spp: Option<u32>,
     /// Seed of every random decision.
     pub seed: u64,
+    /// Whether the reconstruction reads the sampler's cells (the polynomial filter): a sampler
+    /// that keeps cells sums their radiance and sample positions only then.
+    pub reconstruction_reads_cells: bool,
 }
 
 /// Builds a sampler from its checked parameters.

@@ -8,6 +8,7 @@ use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_pixel, RenderingSpace, SamplePoint};
 use acr_parser::{ParamType, Result};
+use sobol_burley::parts;
 
 /// Salt of this sampler's per-pixel keys.
 const SALT: u64 = 0x736f_626c;
@@ -54,22 +55,67 @@ impl PixelPattern for SobolSampler {
     }
 }
 
-/// The per-pixel key and Sobol scramble of one pixel, computed once for its points.
+/// The per-pixel key and Sobol scrambles of one pixel, computed once for its points.
 #[derive(Clone, Copy, Debug)]
 pub struct Scramble {
     key: u64,
-    bits: u32,
+    /// The hashed seed that shuffles the pixel's sample indices.
+    shuffle: u32,
+    /// The hashed seed of each dim's Owen scramble.
+    dims: [u32; MAX_SOBOL_DIMS],
 }
+
+/// The Sobol dims a point takes: film x, y, time, lens u, v.
+const MAX_SOBOL_DIMS: usize = 5;
 
 impl Scramble {
     /// The scramble of pixel `p` under `seed`.
     pub fn of(p: [u32; 2], seed: u64) -> Self {
         let key = pixel_key(p, seed, SALT);
+        let bits = (key ^ (key >> 32)) as u32;
+        // sobol_burley's own seeds for the index shuffle and each dim's scramble
+        // (`sobol_burley::sample`), hashed once here rather than once per point.
+        let base = bits.wrapping_mul(0x9c8f_2d3b);
+        let per_dim = [0x912f_69ba, 0x174f_18ab, 0x691e_72ca, 0xb40c_c1b8];
         Self {
             key,
-            bits: (key ^ (key >> 32)) as u32,
+            shuffle: parts::hash(bits ^ 0x79c6_8e4a),
+            dims: std::array::from_fn(|d| parts::hash(base ^ (d as u32 >> 2) ^ per_dim[d & 3])),
         }
     }
+}
+
+/// Each dim's Sobol matrix applied to a byte of the (bit-reversed) index: the top two bytes,
+/// 256 entries each, so that a point's dim is two lookups rather than a loop over the index's
+/// bits (`sobol_burley::parts::sobol_rev`, which the tables are made from and agree with).
+struct SobolTables([[[u32; 256]; 2]; MAX_SOBOL_DIMS]);
+
+impl SobolTables {
+    fn get() -> &'static Self {
+        static TABLES: std::sync::OnceLock<Box<SobolTables>> = std::sync::OnceLock::new();
+        TABLES.get_or_init(|| {
+            Box::new(SobolTables(std::array::from_fn(|d| {
+                std::array::from_fn(|byte| {
+                    let shift = 24 - 8 * byte as u32;
+                    std::array::from_fn(|v| parts::sobol_rev((v as u32) << shift, d as u32))
+                })
+            })))
+        })
+    }
+
+    /// Dim `d` of the Sobol point with bit-reversed index `rev`, bit-reversed.
+    #[inline]
+    fn rev(&self, rev: u32, d: usize) -> u32 {
+        let t = &self.0[d];
+        t[0][(rev >> 24) as usize] ^ t[1][((rev >> 16) & 0xff) as usize]
+    }
+}
+
+/// The coordinate in [0, 1) of a scrambled, bit-reversed Sobol value (`sobol_burley::sample`'s
+/// last steps).
+#[inline]
+fn to_unit(sobol_rev: u32, scramble: u32) -> f32 {
+    parts::u32_to_f32_norm(parts::owen_scramble_rev(sobol_rev, scramble).reverse_bits())
 }
 
 impl SobolSampler {
@@ -78,14 +124,18 @@ impl SobolSampler {
     pub fn point(&self, p: [u32; 2], index: u32, scramble: Scramble) -> SamplePoint {
         let dims = self.cursor.space().dims;
         let (off, time, lens) = if index < SOBOL_SAMPLES {
-            // One SIMD call gives dims 0-3; v (dim 4) only when the lens is on.
-            let s = sobol_burley::sample_4d(index, 0, scramble.bits);
+            // As `sobol_burley::sample(index, d, seed)` for each dim, bit for bit, with the
+            // index shuffled once for all dims; inactive dims draw nothing.
+            let tables = SobolTables::get();
+            let rev = parts::owen_scramble_rev(index.reverse_bits(), scramble.shuffle);
+            let dim = |d: usize| to_unit(tables.rev(rev, d), scramble.dims[d]);
+            let time = if dims.time { dim(2) } else { 0.5 };
             let lens = if dims.lens {
-                [s[3], sobol_burley::sample(index, 4, scramble.bits)]
+                [dim(3), dim(4)]
             } else {
                 [0.5; 2]
             };
-            ([s[0], s[1]], if dims.time { s[2] } else { 0.5 }, lens)
+            ([dim(0), dim(1)], time, lens)
         } else {
             let mut rng = Pcg32::new(
                 super::mix64(scramble.key ^ super::mix64(u64::from(index))),
@@ -189,6 +239,30 @@ mod tests {
                 }
             }
             eprintln!("sobol spp {spp}: worst 1D star discrepancy {worst:.4} (1/spp bound)");
+        }
+    }
+
+    #[test]
+    fn the_tables_give_sobol_burleys_points_bit_for_bit() {
+        let sp = space(0, 0, 1, 1, ALL_DIMS[3]);
+        let s = SobolSampler::new(sp, 16, 0);
+        for p in [[0, 0], [7, 3], [1000, 20]] {
+            for seed in [0, 5, u64::MAX] {
+                let scramble = Scramble::of(p, seed);
+                let bits = (scramble.key ^ (scramble.key >> 32)) as u32;
+                for index in (0..SOBOL_SAMPLES)
+                    .step_by(7)
+                    .chain([1, 2, 3, SOBOL_SAMPLES - 1])
+                {
+                    let q = s.point(p, index, scramble);
+                    let want = sobol_burley::sample_4d(index, 0, bits);
+                    let film = [in_pixel(p[0], want[0]), in_pixel(p[1], want[1])];
+                    assert_eq!(q.film, film, "{p:?} {index}");
+                    assert_eq!([q.time, q.lens[0]], [want[2], want[3]]);
+                    let v = sobol_burley::sample(index, 4, bits);
+                    assert_eq!(q.lens[1].to_bits(), v.to_bits());
+                }
+            }
         }
     }
 

@@ -14,6 +14,7 @@ pub fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dy
         space,
         spp: Some(spp),
         seed,
+        reconstruction_reads_cells: true,
     };
     (e.build)(&Choice::new(None, name, None), &setup).unwrap()
 }
