@@ -209,12 +209,6 @@ impl FeatureScale {
         }
     }
 
-    /// The feature vector of a cell with coordinates `c`, raw features `(g, s)` and `level`.
-    #[inline]
-    pub fn feature(&self, dims: usize, c: &Coords, g: f32, s: f32, level: f32) -> Feature {
-        self.feature_of(dims, c, self.squash(g, s, level))
-    }
-
     /// The weighted and compressed `(g, s, level)` of a cell: the part of its feature vector
     /// that depends on its samples. Kept per cell, it spares recomputing the logarithms of a
     /// cell's old feature when the cell changes.

@@ -347,15 +347,15 @@ impl CellGrid {
     /// [`Self::cells_per_pixel`]).
     #[inline]
     pub fn pixel_of_cell(&self, i: usize, per_pixel: u32) -> [u32; 2] {
-        let (x0, y0) = (self.space.x0, self.space.y0);
-        if self.pixel_cells {
-            // Cell i is pixel i: one division (this runs once per adaptive sample).
-            let (i, w) = (i as u32, self.shape[0]);
-            return [x0 + i % w, y0 + i / w];
-        }
-        let image = (i / self.stride[0]) as u32;
-        let (cx, cy) = (image % self.shape[0], image / self.shape[0]);
-        [x0 + cx / per_pixel, y0 + cy / per_pixel]
+        let c = self.coords(i);
+        // Whole-pixel cells (the default) need no division here: this runs once per adaptive
+        // sample.
+        let (px, py) = if per_pixel == 1 {
+            (c[0], c[1])
+        } else {
+            (c[0] / per_pixel, c[1] / per_pixel)
+        };
+        [self.space.x0 + px, self.space.y0 + py]
     }
 
     /// The image cell (x, y cell coordinates) holding the centre of pixel `(px, py)`, given
