@@ -39,9 +39,19 @@ pub fn level(grid: &CellGrid, sums: &CellSums, i: usize) -> f32 {
 
 /// The raw affine-invariant gradient `g` and variance `s` of cell `i`, from the levels.
 pub fn raw(grid: &CellGrid, sums: &CellSums, levels: &[f32], i: usize) -> (f32, f32) {
+    (raw_gradient(grid, levels, i), raw_variance(grid, sums, i))
+}
+
+/// The raw affine-invariant gradient `g` of cell `i`, from the levels.
+pub fn raw_gradient(grid: &CellGrid, levels: &[f32], i: usize) -> f32 {
     let c = grid.coords(i);
     let g = interior_gradient(grid, levels, i, &c).unwrap_or_else(|| gradient(grid, levels, i, &c));
-    (g as f32, variance(grid, sums, i, &c) as f32)
+    g as f32
+}
+
+/// The raw variance `s` of cell `i`, from the sums alone.
+pub fn raw_variance(grid: &CellGrid, sums: &CellSums, i: usize) -> f32 {
+    variance(grid, sums, i, &grid.coords(i)) as f32
 }
 
 /// [`gradient`] for a cell with both neighbours along every dim of more than one cell (and

@@ -13,10 +13,10 @@ use super::{
 };
 use crate::cluster::build::{initial_clustering, ClusterParams};
 use crate::cluster::clusters::UNASSIGNED;
-use crate::cluster::features::{level, raw, Squashed};
+use crate::cluster::features::{level, raw_gradient, raw_variance, Squashed};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::queue::{BucketQueue, Queued};
-use crate::cluster::{CellGrid, CellSums, CellView, Cluster, Clustering, FeatureScale};
+use crate::cluster::{CellGrid, CellSums, CellView, Clustering, FeatureScale};
 use crate::partition::Partition;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{RenderingSpace, SamplePoint};
@@ -34,6 +34,10 @@ const PICKS_PER_TASK: usize = 64;
 
 /// Smallest round, in samples: enough to keep every thread busy.
 const MIN_ROUND: u64 = 4096;
+
+/// Changed cells whose clusters are read ahead of their moves at a time (see
+/// [`Clustering::warm`]).
+const WARM_RUN: usize = 16;
 
 /// How the next clusters to sample are chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,6 +147,14 @@ struct Change {
     samples: u32,
 }
 
+/// What an update reads of a touched cell's own sums (an empty neighbour's: its level alone).
+#[derive(Clone, Copy, Debug)]
+struct CellUpdate {
+    level: f32,
+    variance: f32,
+    samples: u32,
+}
+
 /// The adaptive cluster sampler.
 pub struct ClusterSampler {
     settings: ClusterSettings,
@@ -165,8 +177,6 @@ pub struct ClusterSampler {
     remaining: u64,
     queue: BucketQueue,
     version: Vec<u32>,
-    /// Samples planned for each cluster in the round being planned.
-    planned: Vec<u64>,
     /// The clusters sampled in the round under way.
     round_clusters: Vec<u32>,
     /// The cell and in-cell offsets of each point of the round under way, in batch order.
@@ -183,7 +193,7 @@ pub struct ClusterSampler {
     empty_cells: usize,
     /// The update's buffers, kept from round to round: fresh ones cost page faults.
     dirty: Vec<u32>,
-    new_levels: Vec<f32>,
+    cell_updates: Vec<CellUpdate>,
     changes: Vec<Change>,
     rounds: u64,
     partition: Option<Partition>,
@@ -223,7 +233,6 @@ impl ClusterSampler {
             pixel_count: vec![0; pixels as usize],
             queue: BucketQueue::new(),
             version: Vec::new(),
-            planned: Vec::new(),
             round_clusters: Vec::new(),
             round_cells: Vec::new(),
             drawn: Vec::new(),
@@ -231,7 +240,7 @@ impl ClusterSampler {
             cluster_marks: Vec::new(),
             empty_cells: cells,
             dirty: Vec::new(),
-            new_levels: Vec::new(),
+            cell_updates: Vec::new(),
             changes: Vec::new(),
             rounds: 0,
             partition: None,
@@ -269,29 +278,48 @@ impl ClusterSampler {
             + self.queue.bytes()
     }
 
-    /// The sampling priority of `c` with `extra` samples planned on top of its own.
-    fn priority(&self, c: &Cluster, extra: u64) -> f64 {
-        let tolerance = self.clustering.as_ref().map_or(0.0, |k| k.rule.tolerance);
+    /// The sampling priority of a queued cluster.
+    fn priority(&self, e: &Queued) -> f64 {
         match self.settings.priority {
+            Priority::Paper => e.weight,
+            Priority::PerSample => e.weight / e.samples.max(1) as f64,
+        }
+    }
+
+    /// The queue entry of cluster `id` as it stands, with its priority; none for a dead one.
+    fn entry(&self, id: u32) -> Option<(f64, Queued)> {
+        let clustering = self.clustering.as_ref().expect("clustered");
+        let c = &clustering.clusters[id as usize];
+        if c.cells.is_empty() {
+            return None;
+        }
+        let weight = match self.settings.priority {
             Priority::Paper => c.err(),
             Priority::PerSample => {
                 // A cluster of cells that agree has err 0 however noisy or curved they are:
                 // its mean gradient and variance features count too.
                 let mean = c.mean();
-                let err = c.err() + mean[0].abs() + mean[1].abs() + tolerance;
-                err * c.cells.len() as f64 / (c.samples + extra).max(1) as f64
+                let err = c.err() + mean[0].abs() + mean[1].abs() + clustering.rule.tolerance;
+                err * c.cells.len() as f64
             }
-        }
+        };
+        let e = Queued {
+            id,
+            version: self.version[id as usize],
+            cells: c.cells.len() as u32,
+            samples: c.samples,
+            weight,
+        };
+        Some((self.priority(&e), e))
     }
 
-    fn push(&mut self, id: u32) {
-        let c = &self.clustering.as_ref().expect("clustered").clusters[id as usize];
-        if c.cells.is_empty() {
-            return;
+    /// Queues the clusters `ids` in the order given.
+    fn push_all(&mut self, ids: &[u32]) {
+        for &id in ids {
+            if let Some((priority, e)) = self.entry(id) {
+                self.queue.push(priority, e);
+            }
         }
-        let priority = self.priority(c, 0);
-        let version = self.version[id as usize];
-        self.queue.push(priority, Queued { id, version });
     }
 
     /// Ends the first stage: every cell's level and features, their scales, the clusters.
@@ -302,11 +330,9 @@ impl ClusterSampler {
         self.scale = Some(initial.scale);
         let clustering = initial.clustering;
         self.version = vec![0; clustering.clusters.len()];
-        self.planned = vec![0; clustering.clusters.len()];
         self.clustering = Some(clustering);
-        for id in 0..self.version.len() as u32 {
-            self.push(id);
-        }
+        let all: Vec<u32> = (0..self.version.len() as u32).collect();
+        self.push_all(&all);
     }
 
     /// Plans the next round into `out`: clusters by priority, a few samples each, until the
@@ -319,7 +345,7 @@ impl ClusterSampler {
         let mut planned_total = 0;
         let mut deferred = Vec::new();
         while planned_total < target {
-            let Some(top) = self.queue.pop() else {
+            let Some(mut top) = self.queue.pop() else {
                 if deferred.is_empty() {
                     break;
                 }
@@ -328,29 +354,28 @@ impl ClusterSampler {
                 }
                 continue;
             };
-            let clustering = self.clustering.as_ref().expect("clustered");
-            let c = &clustering.clusters[top.id as usize];
-            if c.cells.is_empty() || self.version[top.id as usize] != top.version {
+            // A live entry's cluster has cells: a cluster that loses its last one changes
+            // version.
+            if self.version[top.id as usize] != top.version {
                 continue;
             }
-            let k = (c.cells.len() as u64)
+            let k = u64::from(top.cells)
                 .clamp(CLUSTER_SAMPLES.0, CLUSTER_SAMPLES.1)
                 .min(target - planned_total);
             picks.push((top.id, k));
             planned_total += k;
-            self.planned[top.id as usize] += k;
+            top.samples += k;
+            let priority = self.priority(&top);
             match self.settings.priority {
-                Priority::PerSample => {
-                    let priority = self.priority(c, self.planned[top.id as usize]);
-                    self.queue.push(priority, top);
-                }
+                Priority::PerSample => self.queue.push(priority, top),
                 // The paper's rule takes each cluster once per round, by largest error.
-                Priority::Paper => deferred.push((self.priority(c, 0), top)),
+                Priority::Paper => deferred.push((priority, top)),
             }
         }
         for (priority, e) in deferred {
             self.queue.push(priority, e);
         }
+
         // Every planned sample is spent, whether or not it comes back valid.
         let clustering = self.clustering.as_mut().expect("clustered");
         for &(id, k) in &picks {
@@ -373,7 +398,8 @@ impl ClusterSampler {
             let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
             self.draw_cells(&picks, &mut rng, out);
         }
-        self.round_clusters = picks.iter().map(|&(id, _)| id).collect();
+        self.round_clusters.clear();
+        self.round_clusters.extend(picks.iter().map(|&(id, _)| id));
         self.remaining -= planned_total;
         self.rounds += 1;
     }
@@ -403,9 +429,6 @@ impl ClusterSampler {
         let per_pixel = self.grid.cells_per_pixel();
         let width = self.space.width() as usize;
         let rows = self.space.height() as usize;
-        for &(id, _) in picks {
-            self.planned[id as usize] = 0;
-        }
         // Each pick draws from its own stream, so that picks are drawn in parallel and the
         // pixels do not depend on the thread count.
         let round_key = mix64(self.seed ^ SALT ^ mix64(self.rounds));
@@ -415,10 +438,18 @@ impl ClusterSampler {
             .enumerate()
             .map(|(g, group)| {
                 let mut drawn = Vec::new();
-                for (n, &(id, k)) in group.iter().enumerate() {
+                // Every pick's cell list, then its first cell, before drawing: independent
+                // reads whose cache misses overlap, where drawing pick after pick waited on
+                // two misses each (the clusters are cold after tracing).
+                let lists: Vec<&[u32]> = group
+                    .iter()
+                    .map(|&(id, _)| clustering.clusters[id as usize].cells.as_slice())
+                    .collect();
+                let first = lists.iter().filter_map(|l| l.first());
+                std::hint::black_box(first.fold(0u32, |a, &c| a ^ c));
+                for (n, (&(_, k), cells)) in group.iter().zip(&lists).enumerate() {
                     let stream = (g * PICKS_PER_TASK + n) as u64;
                     let mut rng = Pcg32::new(round_key, stream);
-                    let cells = &clustering.clusters[id as usize].cells;
                     for slot in Self::slots(&mut rng, cells.len(), k) {
                         let cell = cells[slot] as usize;
                         let pixel = match per_pixel {
@@ -438,6 +469,7 @@ impl ClusterSampler {
                 drawn
             })
             .collect();
+
         let mut drawn = std::mem::take(&mut self.drawn);
         drawn.clear();
         drawn.extend(groups.into_iter().flatten());
@@ -456,14 +488,16 @@ impl ClusterSampler {
         for &p in &drawn {
             let (row, col) = ((p >> 32) as u32, p as u32);
             let r = &mut start[row as usize];
-            let index = &mut self.pixel_count[row as usize * width + col as usize];
-            out[*r] = SamplePoint {
-                pixel: [x0 + col, y0 + row],
-                index: *index,
-                ..SamplePoint::UNMADE
-            };
-            *index += 1;
+            out[*r].pixel = [x0 + col, y0 + row];
             *r += 1;
+        }
+        // The indices after the sort, in row order: pixel counts read a row at a time rather
+        // than at random (each read missed the cache: 18% of the planning's time). A pixel's
+        // points keep their draw order, so they get the same indices either way.
+        for q in out.iter_mut() {
+            let p = (q.pixel[1] - y0) as usize * width + (q.pixel[0] - x0) as usize;
+            q.index = self.pixel_count[p];
+            self.pixel_count[p] += 1;
         }
         self.drawn = drawn;
     }
@@ -475,7 +509,6 @@ impl ClusterSampler {
         let n = self.grid.dims();
         let mut points: Vec<(SamplePoint, u32, [f32; MAX_DIMS])> = Vec::new();
         for &(id, k) in picks {
-            self.planned[id as usize] = 0;
             let cells = &clustering.clusters[id as usize].cells;
             for slot in Self::slots(rng, cells.len(), k) {
                 let mut u = [0.5f32; MAX_DIMS];
@@ -528,6 +561,7 @@ impl ClusterSampler {
                 *bits &= *bits - 1;
             }
         }
+
         let (grid, sums) = (&self.grid, &self.sums);
         let mut empty: Vec<u32> = Vec::new();
         if self.empty_cells > 0 {
@@ -544,18 +578,33 @@ impl ClusterSampler {
             empty.dedup();
             self.empty_cells = sums.count.par_iter().filter(|&&n| n == 0).count();
         }
-        let mut new_levels = std::mem::take(&mut self.new_levels);
+        // Levels, and what else the features read of a touched cell's own sums, in one pass:
+        // read again in the next pass, those sums had left the cache (a fifth of the features'
+        // time at 700x700, by `perf annotate`).
+        let mut updates = std::mem::take(&mut self.cell_updates);
         dirty
             .par_iter()
             .chain(empty.par_iter())
-            .map(|&i| level(grid, sums, i as usize))
-            .collect_into_vec(&mut new_levels);
-        for (&i, &l) in dirty.iter().chain(&empty).zip(&new_levels) {
-            self.levels[i as usize] = l;
+            .enumerate()
+            .map(|(k, &i)| {
+                let i = i as usize;
+                let touched = k < dirty.len();
+                CellUpdate {
+                    level: level(grid, sums, i),
+                    variance: if touched {
+                        raw_variance(grid, sums, i)
+                    } else {
+                        0.0
+                    },
+                    samples: sums.count[i],
+                }
+            })
+            .collect_into_vec(&mut updates);
+        for (&i, f) in dirty.iter().chain(&empty).zip(&updates) {
+            self.levels[i as usize] = f.level;
         }
-        self.new_levels = new_levels;
         let mut nbrs = Vec::new();
-        let (grid, sums) = (&self.grid, &self.sums);
+        let grid = &self.grid;
         let levels = &self.levels;
         let scale = self.scale.expect("clustered");
         let n = grid.dims();
@@ -564,39 +613,42 @@ impl ClusterSampler {
         // made in parallel: the moves below are the only serial part.
         let mut changes = std::mem::take(&mut self.changes);
         changes.clear();
-        changes.par_extend(dirty.par_iter().filter_map(|&i| {
+        changes.par_extend(dirty.par_iter().zip(&updates).filter_map(|(&i, f)| {
             let i = i as usize;
-            let (g, s) = raw(grid, sums, levels, i);
-            let q = scale.squash(g, s, levels[i]);
+            let g = raw_gradient(grid, levels, i);
+            let q = scale.squash(g, f.variance, f.level);
             // What the serial moves below read of the cell, read here in parallel: at 1024x1024
             // those reads missed the cache one after another.
             (q != squashed[i]).then_some(Change {
                 cell: i as u32,
                 old: squashed[i],
                 new: q,
-                samples: sums.count[i],
+                samples: f.samples,
             })
         }));
+        self.cell_updates = updates;
         let clustering = self.clustering.as_mut().expect("clustered");
         let mut changed: Vec<u32> = std::mem::take(&mut self.round_clusters);
-        for change in &changes {
-            let i = change.cell as usize;
-            let c = grid.coords(i);
-            let (old, new) = (
-                scale.feature_of(n, &c, change.old),
-                scale.feature_of(n, &c, change.new),
-            );
-            self.squashed[i] = change.new;
-            let samples = u64::from(change.samples);
-            let (a, b) = clustering.update(grid, i, &old, &new, samples, &mut nbrs);
-            changed.push(a);
-            changed.extend(b);
+        for run in changes.chunks(WARM_RUN) {
+            clustering.warm(run.iter().map(|c| c.cell as usize));
+            for change in run {
+                let i = change.cell as usize;
+                let c = grid.coords(i);
+                let (old, new) = (
+                    scale.feature_of(n, &c, change.old),
+                    scale.feature_of(n, &c, change.new),
+                );
+                self.squashed[i] = change.new;
+                let samples = u64::from(change.samples);
+                let (a, b) = clustering.update(grid, i, &old, &new, samples, &mut nbrs);
+                changed.push(a);
+                changed.extend(b);
+            }
         }
         (self.dirty, self.changes) = (dirty, changes);
         let live = clustering.live();
         if self.version.len() < clustering.clusters.len() {
             self.version.resize(clustering.clusters.len(), 0);
-            self.planned.resize(clustering.clusters.len(), 0);
         }
         // Each changed cluster once, in the order of its first change: a bit per cluster
         // rather than a sort (4% of the sampler's instructions, by callgrind).
@@ -617,14 +669,11 @@ impl ClusterSampler {
         if self.queue.len() > 2 * live + 1024 {
             // Mostly stale entries: rebuild.
             self.queue.clear();
-            for id in 0..self.version.len() as u32 {
-                self.push(id);
-            }
-        } else {
-            for id in changed {
-                self.push(id);
-            }
+            changed.clear();
+            changed.extend(0..self.version.len() as u32);
         }
+        self.push_all(&changed);
+        self.round_clusters = changed;
     }
 
     /// The final partition in image space: each pixel takes the cluster of most of the cells
@@ -967,6 +1016,58 @@ mod tests {
             0.2
         };
         [v, v * 0.5, v * 0.25]
+    }
+
+    /// Checks that each live cluster has one current queue entry and that it agrees with the
+    /// cluster; returns the entries checked.
+    fn check_queue(s: &ClusterSampler) -> usize {
+        let Some(clustering) = s.clustering() else {
+            return 0;
+        };
+        let mut seen = vec![0u32; clustering.clusters.len()];
+        let mut checked = 0;
+        for e in s.queue.iter() {
+            if s.version[e.id as usize] != e.version {
+                continue;
+            }
+            seen[e.id as usize] += 1;
+            let c = &clustering.clusters[e.id as usize];
+            let (p, now) = s.entry(e.id).expect("a current entry's cluster lives");
+            assert_eq!(e.cells as usize, c.cells.len());
+            assert_eq!(e.samples, c.samples, "cluster {}", e.id);
+            assert_eq!(e.weight.to_bits(), now.weight.to_bits());
+            assert_eq!(s.priority(e).to_bits(), p.to_bits());
+            checked += 1;
+        }
+        for (id, c) in clustering.clusters.iter().enumerate() {
+            assert_eq!(seen[id], u32::from(!c.cells.is_empty()), "cluster {id}");
+        }
+        checked
+    }
+
+    #[test]
+    fn each_live_cluster_has_one_current_queue_entry_that_agrees_with_it() {
+        // The planning reads the entries, not the clusters: an entry whose cells, samples or
+        // weight fell behind its cluster would choose wrongly without a sign. Checked after
+        // each plan (the chosen clusters' entries went back with their planned samples) and
+        // after each update (the changed clusters' entries were made again).
+        for priority in [Priority::PerSample, Priority::Paper] {
+            let set = ClusterSettings {
+                priority,
+                ..ClusterSettings::new(12)
+            };
+            let sp = space(0, 0, 48, 32, ALL_DIMS[1]);
+            let mut s = ClusterSampler::new(sp, set, 9);
+            let mut b = Vec::new();
+            let mut checked = 0;
+            while s.next_batch(&mut b) {
+                checked += check_queue(&s);
+                let r: Vec<[f32; 3]> = b.iter().map(field).collect();
+                s.observe(&b, &r);
+                checked += check_queue(&s);
+            }
+            assert!(checked > 1000, "{checked}");
+        }
     }
 
     #[test]
