@@ -314,8 +314,8 @@ impl ClusterSampler {
     }
 
     /// Queues the clusters `ids` in the order given.
-    fn push_all(&mut self, ids: &[u32]) {
-        for &id in ids {
+    fn push_all(&mut self, ids: impl IntoIterator<Item = u32>) {
+        for id in ids {
             if let Some((priority, e)) = self.entry(id) {
                 self.queue.push(priority, e);
             }
@@ -331,8 +331,7 @@ impl ClusterSampler {
         let clustering = initial.clustering;
         self.version = vec![0; clustering.clusters.len()];
         self.clustering = Some(clustering);
-        let all: Vec<u32> = (0..self.version.len() as u32).collect();
-        self.push_all(&all);
+        self.push_all(0..self.version.len() as u32);
     }
 
     /// Plans the next round into `out`: clusters by priority, a few samples each, until the
@@ -469,7 +468,6 @@ impl ClusterSampler {
                 drawn
             })
             .collect();
-
         let mut drawn = std::mem::take(&mut self.drawn);
         drawn.clear();
         drawn.extend(groups.into_iter().flatten());
@@ -561,7 +559,6 @@ impl ClusterSampler {
                 *bits &= *bits - 1;
             }
         }
-
         let (grid, sums) = (&self.grid, &self.sums);
         let mut empty: Vec<u32> = Vec::new();
         if self.empty_cells > 0 {
@@ -672,7 +669,7 @@ impl ClusterSampler {
             changed.clear();
             changed.extend(0..self.version.len() as u32);
         }
-        self.push_all(&changed);
+        self.push_all(changed.iter().copied());
         self.round_clusters = changed;
     }
 
