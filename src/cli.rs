@@ -4,9 +4,10 @@ use crate::aov::{parse_aovs, write_aov, AovRequest};
 use crate::image_io::{write_image, RgbImage};
 use crate::registry::{choose_for_scene, Overrides};
 use crate::render::{render, MAX_SPP};
+use crate::replay::Recording;
 use crate::scene::Scene;
 use crate::stats::{peak_rss_mb, Seconds, Stats};
-use acr_plugins::Setting;
+use acr_plugins::{Sampler, Setting};
 use clap::{Parser, Subcommand};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -98,6 +99,11 @@ pub struct RenderArgs {
     /// Write run statistics as JSON to this file.
     #[arg(long)]
     pub stats: Option<PathBuf>,
+    /// Also measure what the sampler adds to the render's wall time: its batches are traced
+    /// again by a sampler that only replays them (same image, checked), and the stats give
+    /// both times and the sampler's share. Holds every point in memory (32 bytes each).
+    #[arg(long)]
+    pub sampler_cost: bool,
     /// No progress bar and no summary line.
     #[arg(long, short = 'q')]
     pub quiet: bool,
@@ -227,10 +233,16 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         b
     });
     let spp = plugins.sampler.spp();
+    let mut recording = Recording::new(plugins.sampler.as_mut());
+    let sampler: &mut dyn Sampler = if args.sampler_cost {
+        &mut recording
+    } else {
+        recording.inner()
+    };
     let counts = render(
         &scene,
         &plugins.integrator,
-        plugins.sampler.as_mut(),
+        sampler,
         &mut film,
         args.seed,
         args.time_limit.map(std::time::Duration::from_secs_f64),
@@ -240,6 +252,27 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         b.finish_and_clear();
     }
     let t_rendered = Instant::now();
+    let replay_s = if args.sampler_cost {
+        let mut replay = recording.replay();
+        let mut again = plugins.film(&scene);
+        let t = Instant::now();
+        render(
+            &scene,
+            &plugins.integrator,
+            &mut replay,
+            &mut again,
+            args.seed,
+            None,
+            None,
+        );
+        let replay_s = t.elapsed().as_secs_f64();
+        if again.pixels() != film.pixels() {
+            return Err("--sampler-cost: the replayed batches gave another image".into());
+        }
+        Some(replay_s)
+    } else {
+        None
+    };
 
     let (w, h) = scene.film.size();
     let image = RgbImage {
@@ -289,6 +322,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             build: (t_built - t_parsed).as_secs_f64(),
             render: render_s,
             sampler: counts.sampler_seconds,
+            replay: replay_s,
             reconstruct: (t_reconstructed - t_rendered).as_secs_f64(),
             write: (t_written - t_reconstructed).as_secs_f64(),
             total: t_start.elapsed().as_secs_f64(),
@@ -298,6 +332,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         } else {
             0.0
         },
+        sampler_share: replay_s.map(|r| ((render_s - r) / render_s.max(1e-9)).max(0.0)),
         peak_rss_mb: peak_rss_mb(),
     };
     if let Some(path) = &args.stats {

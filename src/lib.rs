@@ -18,6 +18,7 @@ pub mod metrics;
 pub mod microfacet;
 pub mod registry;
 pub mod render;
+pub mod replay;
 pub mod sampling;
 pub mod scene;
 pub mod shapes;

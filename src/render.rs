@@ -66,6 +66,44 @@ pub fn render(
     render_with(scene, &li, sampler, film, seed, time_limit, progress)
 }
 
+/// A traced batch and what became of its samples, waiting for the sampler and the film.
+#[derive(Default)]
+struct Traced {
+    batch: Vec<SamplePoint>,
+    /// Each point's radiance, clamped by the film's limits; NaN where it was dropped.
+    radiance: Vec<[f32; 3]>,
+    /// The film position and radiance of each sample kept.
+    valid: Vec<(Vec2, Spectrum)>,
+}
+
+impl Traced {
+    /// Takes `results` of `self.batch`: counts them, drops radiance that is NaN, infinite or
+    /// negative, and clamps the rest by the film's limits.
+    fn take(&mut self, results: &[(Spectrum, u32)], film: &Film, counts: &mut RenderCounts) {
+        self.valid.clear();
+        self.radiance.clear();
+        for (q, &(l, rays)) in self.batch.iter().zip(results) {
+            counts.rays += u64::from(rays);
+            if is_valid_radiance(l) {
+                let l = film.settings().clamp(l);
+                self.valid.push((Vec2::from(q.film), l));
+                self.radiance.push(l.to_array());
+            } else {
+                counts.dropped += 1;
+                // NaN marks a dropped sample for adaptive samplers, which must skip it.
+                self.radiance.push([f32::NAN; 3]);
+            }
+        }
+        counts.samples += self.batch.len() as u64;
+    }
+
+    /// Adds the batch's samples to `film`.
+    fn add_to(&self, film: &mut Film) {
+        film.add_points(&self.batch, &self.radiance);
+        film.add_samples(&self.valid);
+    }
+}
+
 /// What a sample estimates: the radiance arriving along a camera ray.
 pub type Estimator<'a> = dyn Fn(&Scene, Ray, &mut SampleStream) -> Radiance + Sync + 'a;
 
@@ -88,19 +126,7 @@ pub fn render_with(
     if let Some(p) = progress {
         p.set_length(space.pixels() * u64::from(sampler.spp()));
     }
-    // Reused by every batch: a fresh half-megabyte vector per batch costs page faults.
-    let mut batch: Vec<SamplePoint> = Vec::new();
-    let mut results: Vec<(Spectrum, u32)> = Vec::new();
-    let mut radiance: Vec<[f32; 3]> = Vec::new();
-    let mut valid: Vec<(Vec2, Spectrum)> = Vec::new();
-    let mut in_sampler = Duration::ZERO;
-    loop {
-        let t = Instant::now();
-        let more = sampler.next_batch(&mut batch);
-        in_sampler += t.elapsed();
-        if !more {
-            break;
-        }
+    let trace = |batch: &[SamplePoint], results: &mut Vec<(Spectrum, u32)>| {
         batch
             .par_iter()
             .map(|q| {
@@ -115,33 +141,67 @@ pub fn render_with(
                 let r = li(scene, ray, &mut stream);
                 (r.l, r.rays)
             })
-            .collect_into_vec(&mut results);
-        valid.clear();
-        radiance.clear();
-        for (q, &(l, rays)) in batch.iter().zip(&results) {
-            counts.rays += u64::from(rays);
-            if is_valid_radiance(l) {
-                let l = film.settings().clamp(l);
-                valid.push((Vec2::from(q.film), l));
-                radiance.push(l.to_array());
-            } else {
-                counts.dropped += 1;
-                // NaN marks a dropped sample for adaptive samplers, which must skip it.
-                radiance.push([f32::NAN; 3]);
-            }
-        }
-        let t = Instant::now();
-        sampler.observe(&batch, &radiance);
-        in_sampler += t.elapsed();
-        film.add_points(&batch, &radiance);
-        film.add_samples(&valid);
-        counts.samples += batch.len() as u64;
+            .collect_into_vec(results);
+    };
+    // Reused from batch to batch: a fresh half-megabyte vector per batch costs page faults.
+    let (mut batch, mut next) = (Vec::new(), Vec::new());
+    let mut results: Vec<(Spectrum, u32)> = Vec::new();
+    // The last batch traced, when the sampler and the film have not yet seen it.
+    let mut traced = Traced::default();
+    let mut pending = false;
+    let mut in_sampler = Duration::ZERO;
+    let t = Instant::now();
+    let mut more = sampler.next_batch(&mut batch);
+    in_sampler += t.elapsed();
+    while more {
+        // While `batch` is traced, the sampler learns from the batch before and, when it
+        // plans ahead, plans the next; the film takes the batch before.
+        let ahead = sampler.plans_ahead();
+        let ((), (planned, took)) = rayon::join(
+            || trace(&batch, &mut results),
+            || {
+                let t = Instant::now();
+                if pending {
+                    sampler.observe(&traced.batch, &traced.radiance);
+                }
+                let planned = ahead.then(|| sampler.next_batch(&mut next));
+                let took = t.elapsed();
+                if pending {
+                    traced.add_to(film);
+                }
+                (planned, took)
+            },
+        );
+        in_sampler += took;
+        std::mem::swap(&mut traced.batch, &mut batch);
+        traced.take(&results, film, &mut counts);
+        pending = true;
         if let Some(p) = progress {
             p.set_position(counts.samples);
         }
         if time_limit.is_some_and(|t| start.elapsed() >= t) {
             sampler.halt();
         }
+        match planned {
+            Some(planned) => {
+                std::mem::swap(&mut batch, &mut next);
+                more = planned;
+            }
+            None => {
+                let t = Instant::now();
+                sampler.observe(&traced.batch, &traced.radiance);
+                more = sampler.next_batch(&mut batch);
+                in_sampler += t.elapsed();
+                traced.add_to(film);
+                pending = false;
+            }
+        }
+    }
+    if pending {
+        let t = Instant::now();
+        sampler.observe(&traced.batch, &traced.radiance);
+        in_sampler += t.elapsed();
+        traced.add_to(film);
     }
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
     counts.sampler_seconds = in_sampler.as_secs_f64();

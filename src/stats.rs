@@ -11,8 +11,12 @@ pub struct Seconds {
     pub build: f64,
     /// Tracing samples (the sampler's time included).
     pub render: f64,
-    /// Of the render, the time spent in the sampler choosing points and learning from them.
+    /// Of the render, the wall time of the sampler's calls (choosing points, learning from
+    /// them). A sampler that plans ahead is called while tracing goes on, and threads waiting
+    /// in its calls take up tracing: then this is more than it adds (see `sampler_share`).
     pub sampler: f64,
+    /// With `--sampler-cost`: the render again, its batches replayed by a sampler doing no work.
+    pub replay: Option<f64>,
     /// Reconstructing the image from the film.
     pub reconstruct: f64,
     /// Writing output files.
@@ -63,6 +67,9 @@ pub struct Stats {
     pub dropped_samples: u64,
     /// Time per phase.
     pub seconds: Seconds,
+    /// With `--sampler-cost`: the share of the render's wall time the sampler added,
+    /// (render - replay) / render.
+    pub sampler_share: Option<f64>,
     /// Millions of rays per second of render time.
     pub mrays_per_s: f64,
     /// Peak resident memory in MiB.

@@ -1026,6 +1026,62 @@ fn every_sampler_gives_the_same_file_with_one_and_two_threads() {
 }
 
 #[test]
+fn a_sampler_planning_ahead_gives_the_same_file_with_one_and_two_threads() {
+    // Large enough for several adaptive rounds, each planned while the one before is traced.
+    let dir = TempDir::new("ahead");
+    let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 64, 48));
+    let run = |threads: &str| {
+        let (out, stats) = (
+            dir.join(format!("c{threads}.exr")),
+            dir.join(format!("c{threads}.json")),
+        );
+        let args = ["--spp", "8", "--sampler", "cluster", "--threads", threads];
+        render_ok(
+            &scene,
+            &out,
+            &[&args[..], &["--stats", stats.to_str().unwrap()]].concat(),
+        );
+        let rounds = read_stats(&stats)["rounds"].as_u64().unwrap();
+        assert!(rounds > 2, "{rounds} rounds");
+        std::fs::read(&out).unwrap()
+    };
+    assert!(run("1") == run("2"), "1 and 2 threads differ");
+}
+
+#[test]
+fn sampler_cost_replays_the_render_and_reports_the_sampler_s_share() {
+    let dir = TempDir::new("cost");
+    let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 64, 48));
+    for sampler in ["cluster", "stratified"] {
+        let (plain, measured, stats) = (
+            dir.join(format!("{sampler}.exr")),
+            dir.join(format!("{sampler}-cost.exr")),
+            dir.join(format!("{sampler}.json")),
+        );
+        let args = ["--spp", "8", "--sampler", sampler];
+        render_ok(&scene, &plain, &args);
+        let cost = ["--sampler-cost", "--stats", stats.to_str().unwrap()];
+        render_ok(&scene, &measured, &[&args[..], &cost[..]].concat());
+        // Recording the batches changes nothing; the replay was checked to give this image.
+        assert!(std::fs::read(&plain).unwrap() == std::fs::read(&measured).unwrap());
+        let s = read_stats(&stats);
+        let replay = s["seconds"]["replay"].as_f64().unwrap();
+        let share = s["sampler_share"].as_f64().unwrap();
+        assert!(replay > 0.0, "{sampler}: replay {replay}");
+        assert!((0.0..1.0).contains(&share), "{sampler}: share {share}");
+    }
+    // Without the flag, neither is reported.
+    let stats = dir.join("none.json");
+    render_ok(
+        &scene,
+        &dir.join("none.exr"),
+        &["--spp", "1", "--stats", stats.to_str().unwrap()],
+    );
+    let s = read_stats(&stats);
+    assert!(s["seconds"]["replay"].is_null() && s["sampler_share"].is_null());
+}
+
+#[test]
 fn the_cluster_sampler_reports_clusters_and_draws_them() {
     let dir = TempDir::new("cluster");
     let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 40, 30));

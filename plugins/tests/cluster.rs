@@ -4,7 +4,7 @@
 //! points do not depend on the thread count. Figures print with `--nocapture`.
 
 use acr_plugins::rng::mix64;
-use acr_plugins::sampler::{ClusterSampler, ClusterSettings};
+use acr_plugins::sampler::{drive, ClusterSampler, ClusterSettings};
 use acr_plugins::{Dims, RenderingSpace, SamplePoint, Sampler};
 
 /// A test integrand: radiance at a point.
@@ -53,16 +53,7 @@ fn defocus_4d(q: &SamplePoint) -> f32 {
 
 /// Runs the sampler to the end on `field`; every point, in order.
 fn run(s: &mut ClusterSampler, field: Field) -> Vec<SamplePoint> {
-    let mut all = Vec::new();
-    let mut batch = Vec::new();
-    let mut radiance = Vec::new();
-    while s.next_batch(&mut batch) {
-        radiance.clear();
-        radiance.extend(batch.iter().map(|q| [field(q); 3]));
-        s.observe(&batch, &radiance);
-        all.extend_from_slice(&batch);
-    }
-    all
+    drive(s, |b| b.iter().map(|q| [field(q); 3]).collect(), None)
 }
 
 /// Where a cell lies against the edge: entirely left, entirely right, or across it.

@@ -155,6 +155,9 @@ struct CellUpdate {
     samples: u32,
 }
 
+/// A planned round's points' cells (and in-cell offsets) and the clusters it sampled.
+type Round = (Vec<(u32, [f32; MAX_DIMS])>, Vec<u32>);
+
 /// The adaptive cluster sampler.
 pub struct ClusterSampler {
     settings: ClusterSettings,
@@ -181,6 +184,10 @@ pub struct ClusterSampler {
     round_clusters: Vec<u32>,
     /// The cell and in-cell offsets of each point of the round under way, in batch order.
     round_cells: Vec<(u32, [f32; MAX_DIMS])>,
+    /// Rounds planned and not yet observed, oldest first: their points' cells and clusters.
+    in_flight: std::collections::VecDeque<Round>,
+    /// Observed rounds' buffers, for reuse.
+    spare: Vec<Round>,
     /// The pixel (row << 32 | column, from the space's corner) of each point drawn in a
     /// round, in draw order (reused).
     drawn: Vec<u64>,
@@ -235,6 +242,8 @@ impl ClusterSampler {
             version: Vec::new(),
             round_clusters: Vec::new(),
             round_cells: Vec::new(),
+            in_flight: Default::default(),
+            spare: Vec::new(),
             drawn: Vec::new(),
             touched: vec![0; cells.div_ceil(64)],
             cluster_marks: Vec::new(),
@@ -340,6 +349,9 @@ impl ClusterSampler {
         let target = (self.remaining / 16)
             .clamp(MIN_ROUND, BATCH_SAMPLES)
             .min(self.remaining);
+        if let Some((cells, clusters)) = self.spare.pop() {
+            (self.round_cells, self.round_clusters) = (cells, clusters);
+        }
         let mut picks: Vec<(u32, u64)> = Vec::new();
         let mut planned_total = 0;
         let mut deferred = Vec::new();
@@ -399,6 +411,11 @@ impl ClusterSampler {
         }
         self.round_clusters.clear();
         self.round_clusters.extend(picks.iter().map(|&(id, _)| id));
+        let round = (
+            std::mem::take(&mut self.round_cells),
+            std::mem::take(&mut self.round_clusters),
+        );
+        self.in_flight.push_back(round);
         self.remaining -= planned_total;
         self.rounds += 1;
     }
@@ -546,7 +563,7 @@ impl ClusterSampler {
 
     /// Table 1's UpdateCluster after a round: new levels and features for the cells that got
     /// samples and their face neighbours, then the cells that no longer fit move.
-    fn update(&mut self) {
+    fn update(&mut self, round_clusters: Vec<u32>) -> Vec<u32> {
         // The cells that got samples get new features; their neighbours' levels follow where
         // those are filled in from them (no samples of their own), but their features wait
         // until they are sampled: recomputing them too (table 1) cost 5 to 11 times as much
@@ -625,7 +642,7 @@ impl ClusterSampler {
         }));
         self.cell_updates = updates;
         let clustering = self.clustering.as_mut().expect("clustered");
-        let mut changed: Vec<u32> = std::mem::take(&mut self.round_clusters);
+        let mut changed: Vec<u32> = round_clusters;
         for run in changes.chunks(WARM_RUN) {
             clustering.warm(run.iter().map(|c| c.cell as usize));
             for change in run {
@@ -670,7 +687,7 @@ impl ClusterSampler {
             changed.extend(0..self.version.len() as u32);
         }
         self.push_all(changed.iter().copied());
-        self.round_clusters = changed;
+        changed
     }
 
     /// The final partition in image space: each pixel takes the cluster of most of the cells
@@ -722,7 +739,8 @@ impl ClusterSampler {
 
     fn finish(&mut self) {
         self.phase = Phase::Done;
-        if self.partition.is_none() {
+        // Made once the rounds still in flight are observed.
+        if self.partition.is_none() && self.in_flight.is_empty() {
             self.partition = self.make_partition();
         }
     }
@@ -771,28 +789,37 @@ impl Sampler for ClusterSampler {
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
         // An adaptive point's cell is known from when it was made; the first stage's are
         // found here, in parallel.
-        let adaptive = self.phase == Phase::Adaptive && self.round_cells.len() == batch.len();
-        if !adaptive {
+        let round = match self.in_flight.front() {
+            Some(r) if r.0.len() == batch.len() => self.in_flight.pop_front(),
+            _ => None,
+        };
+        let Some((cells, clusters)) = round else {
             self.grid.locate_all(batch, &mut self.round_cells);
-        }
+            self.sums.add_batch(&self.round_cells, radiance);
+            return;
+        };
         // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
-        self.sums.add_batch(&self.round_cells, radiance);
-        if adaptive {
-            for (&(cell, _), l) in self.round_cells.iter().zip(radiance) {
-                if !l[0].is_nan() {
-                    self.touched[cell as usize / 64] |= 1 << (cell % 64);
-                }
+        self.sums.add_batch(&cells, radiance);
+        for (&(cell, _), l) in cells.iter().zip(radiance) {
+            if !l[0].is_nan() {
+                self.touched[cell as usize / 64] |= 1 << (cell % 64);
             }
         }
-        if self.phase == Phase::Adaptive {
-            // A round is one batch: update now.
-            self.update();
+        // A round is one batch: update now.
+        let clusters = self.update(clusters);
+        self.spare.push((cells, clusters));
+        if self.phase == Phase::Done {
+            self.finish();
         }
     }
 
     fn halt(&mut self) {
         self.halted = true;
         self.init.halt();
+    }
+
+    fn plans_ahead(&self) -> bool {
+        self.phase == Phase::Adaptive
     }
 
     fn partition(&self) -> Option<&Partition> {
@@ -992,18 +1019,19 @@ mod tests {
         f: impl Fn(&SamplePoint) -> [f32; 3],
         halt_after: Option<usize>,
     ) -> Vec<SamplePoint> {
-        let (mut all, mut b) = (Vec::new(), Vec::new());
-        let mut batches = 0;
-        while s.next_batch(&mut b) {
-            let r: Vec<[f32; 3]> = b.iter().map(&f).collect();
-            s.observe(&b, &r);
-            all.extend_from_slice(&b);
-            batches += 1;
-            if halt_after == Some(batches) {
-                s.halt();
-            }
-        }
-        all
+        super::super::drive(s, |b| b.iter().map(&f).collect(), halt_after)
+    }
+
+    #[test]
+    fn planning_ahead_observes_every_round_before_the_partition_is_made() {
+        let settings = ClusterSettings::new(8);
+        let mut s = ClusterSampler::new(space(0, 0, 128, 96, ALL_DIMS[1]), settings, 3);
+        let all = super::super::drive(&mut s, |b| b.iter().map(field).collect(), None);
+        assert_eq!(all.len(), 128 * 96 * 8);
+        assert!(s.in_flight.is_empty(), "a round was never observed");
+        assert!(s.rounds > 2, "{} rounds", s.rounds);
+        // The partition given is the one of the final clusters, made after the last round.
+        assert_eq!(s.partition(), s.make_partition().as_ref());
     }
 
     fn field(q: &SamplePoint) -> [f32; 3] {

@@ -56,6 +56,12 @@ pub trait Sampler: Send {
     /// pixel has as many samples as the others (at least one pass), then gives no more.
     fn halt(&mut self);
 
+    /// Whether the next batch may be asked for before the last one is observed (so that it is
+    /// planned while that one is traced); the order of calls is the same whatever the timing.
+    fn plans_ahead(&self) -> bool {
+        false
+    }
+
     /// The sampler's clusters, for the reconstruction, when it has any.
     fn partition(&self) -> Option<&Partition> {
         None
@@ -295,6 +301,53 @@ impl<T: PixelPattern> Sampler for T {
     fn halt(&mut self) {
         self.cursor_mut().halt();
     }
+
+    fn plans_ahead(&self) -> bool {
+        // Its points depend on nothing it observes.
+        true
+    }
+}
+
+/// Runs `sampler` to the end in the render loop's order of calls (a sampler that plans ahead
+/// is asked for the next batch before it observes the last), with `radiance` of each batch,
+/// halting after `halt_after` batches if given; every point given, in order.
+pub fn drive(
+    sampler: &mut dyn Sampler,
+    mut radiance: impl FnMut(&[SamplePoint]) -> Vec<[f32; 3]>,
+    halt_after: Option<usize>,
+) -> Vec<SamplePoint> {
+    let (mut all, mut batch, mut next) = (Vec::new(), Vec::new(), Vec::new());
+    let mut pending: Option<(Vec<SamplePoint>, Vec<[f32; 3]>)> = None;
+    let mut batches = 0;
+    let mut more = sampler.next_batch(&mut batch);
+    while more {
+        let ahead = sampler.plans_ahead();
+        // What the render loop does while `batch` is traced.
+        let r = radiance(&batch);
+        if let Some((b, r)) = pending.take() {
+            sampler.observe(&b, &r);
+        }
+        let planned = ahead.then(|| sampler.next_batch(&mut next));
+        all.extend_from_slice(&batch);
+        batches += 1;
+        if halt_after == Some(batches) {
+            sampler.halt();
+        }
+        match planned {
+            Some(planned) => {
+                pending = Some((std::mem::replace(&mut batch, std::mem::take(&mut next)), r));
+                more = planned;
+            }
+            None => {
+                sampler.observe(&batch, &r);
+                more = sampler.next_batch(&mut batch);
+            }
+        }
+    }
+    if let Some((b, r)) = pending {
+        sampler.observe(&b, &r);
+    }
+    all
 }
 
 /// An estimate in f64, as a pixel's radiance: never negative (the image-space samplers'

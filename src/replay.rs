@@ -1,0 +1,103 @@
+//! What a sampler adds to a render's wall time (`acr render --sampler-cost`): its batches are
+//! recorded, then traced again in the same order by a sampler that only gives them back. The
+//! image is the same; the difference in wall time is the sampler's, whether or not its work
+//! overlapped tracing.
+
+use acr_plugins::{SamplePoint, Sampler};
+use std::collections::VecDeque;
+
+/// Records the batches of the sampler it wraps (every point of the render: 32 bytes each).
+pub struct Recording<'a> {
+    inner: &'a mut dyn Sampler,
+    batches: Vec<Vec<SamplePoint>>,
+}
+
+impl<'a> Recording<'a> {
+    /// Wraps `inner`.
+    pub fn new(inner: &'a mut dyn Sampler) -> Self {
+        Self {
+            inner,
+            batches: Vec::new(),
+        }
+    }
+
+    /// The wrapped sampler, to render without recording.
+    pub fn inner(&mut self) -> &mut dyn Sampler {
+        &mut *self.inner
+    }
+
+    /// A sampler that gives the recorded batches again.
+    pub fn replay(self) -> Replay {
+        Replay {
+            spp: self.inner.spp(),
+            batches: self.batches.into(),
+        }
+    }
+}
+
+impl Sampler for Recording<'_> {
+    fn name(&self) -> &'static str {
+        self.inner.name()
+    }
+
+    fn spp(&self) -> u32 {
+        self.inner.spp()
+    }
+
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+        let more = self.inner.next_batch(out);
+        if more {
+            self.batches.push(out.clone());
+        }
+        more
+    }
+
+    fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        self.inner.observe(batch, radiance);
+    }
+
+    fn halt(&mut self) {
+        self.inner.halt();
+    }
+
+    fn plans_ahead(&self) -> bool {
+        self.inner.plans_ahead()
+    }
+}
+
+/// Gives recorded batches again, in order, doing no work of its own.
+pub struct Replay {
+    spp: u32,
+    batches: VecDeque<Vec<SamplePoint>>,
+}
+
+impl Sampler for Replay {
+    fn name(&self) -> &'static str {
+        "replay"
+    }
+
+    fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+        match self.batches.pop_front() {
+            Some(b) => {
+                *out = b;
+                true
+            }
+            None => {
+                out.clear();
+                false
+            }
+        }
+    }
+
+    fn halt(&mut self) {
+        // The recording stopped where the time limit stopped it.
+    }
+
+    fn plans_ahead(&self) -> bool {
+        true
+    }
+}
