@@ -239,6 +239,8 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     } else {
         recording.inner()
     };
+    // The share compares the two render loops alone, timed alike.
+    let t_loop = Instant::now();
     let counts = render(
         &scene,
         &plugins.integrator,
@@ -248,6 +250,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         args.time_limit.map(std::time::Duration::from_secs_f64),
         bar.as_ref(),
     );
+    let loop_s = t_loop.elapsed().as_secs_f64();
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -332,7 +335,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         } else {
             0.0
         },
-        sampler_share: replay_s.map(|r| ((render_s - r) / render_s.max(1e-9)).max(0.0)),
+        sampler_share: replay_s.map(|r| ((loop_s - r) / loop_s.max(1e-9)).max(0.0)),
         peak_rss_mb: peak_rss_mb(),
     };
     if let Some(path) = &args.stats {

@@ -97,11 +97,20 @@ impl Traced {
         counts.samples += self.batch.len() as u64;
     }
 
-    /// Adds the batch's samples to `film`.
-    fn add_to(&self, film: &mut Film) {
+    /// Gives the batch to the sampler (its time added to `in_sampler`), then to the film.
+    fn hand_over(&self, sampler: &mut dyn Sampler, film: &mut Film, in_sampler: &mut Duration) {
+        timed(in_sampler, || sampler.observe(&self.batch, &self.radiance));
         film.add_points(&self.batch, &self.radiance);
         film.add_samples(&self.valid);
     }
+}
+
+/// Runs `f`, adding its wall time to `total`.
+fn timed<T>(total: &mut Duration, f: impl FnOnce() -> T) -> T {
+    let t = Instant::now();
+    let r = f();
+    *total += t.elapsed();
+    r
 }
 
 /// What a sample estimates: the radiance arriving along a camera ray.
@@ -150,29 +159,20 @@ pub fn render_with(
     let mut traced = Traced::default();
     let mut pending = false;
     let mut in_sampler = Duration::ZERO;
-    let t = Instant::now();
-    let mut more = sampler.next_batch(&mut batch);
-    in_sampler += t.elapsed();
+    let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
     while more {
-        // While `batch` is traced, the sampler learns from the batch before and, when it
-        // plans ahead, plans the next; the film takes the batch before.
+        // While `batch` is traced, the sampler and the film take the batch before and, when
+        // the sampler plans ahead, it plans the next.
         let ahead = sampler.plans_ahead();
-        let ((), (planned, took)) = rayon::join(
+        let ((), planned) = rayon::join(
             || trace(&batch, &mut results),
             || {
-                let t = Instant::now();
                 if pending {
-                    sampler.observe(&traced.batch, &traced.radiance);
+                    traced.hand_over(sampler, film, &mut in_sampler);
                 }
-                let planned = ahead.then(|| sampler.next_batch(&mut next));
-                let took = t.elapsed();
-                if pending {
-                    traced.add_to(film);
-                }
-                (planned, took)
+                ahead.then(|| timed(&mut in_sampler, || sampler.next_batch(&mut next)))
             },
         );
-        in_sampler += took;
         std::mem::swap(&mut traced.batch, &mut batch);
         traced.take(&results, film, &mut counts);
         pending = true;
@@ -188,20 +188,14 @@ pub fn render_with(
                 more = planned;
             }
             None => {
-                let t = Instant::now();
-                sampler.observe(&traced.batch, &traced.radiance);
-                more = sampler.next_batch(&mut batch);
-                in_sampler += t.elapsed();
-                traced.add_to(film);
+                traced.hand_over(sampler, film, &mut in_sampler);
                 pending = false;
+                more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
             }
         }
     }
     if pending {
-        let t = Instant::now();
-        sampler.observe(&traced.batch, &traced.radiance);
-        in_sampler += t.elapsed();
-        traced.add_to(film);
+        traced.hand_over(sampler, film, &mut in_sampler);
     }
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
     counts.sampler_seconds = in_sampler.as_secs_f64();

@@ -68,7 +68,7 @@ pub struct Stats {
     /// Time per phase.
     pub seconds: Seconds,
     /// With `--sampler-cost`: the share of the render's wall time the sampler added,
-    /// (render - replay) / render.
+    /// (render - replay) / render, both the render loop alone.
     pub sampler_share: Option<f64>,
     /// Millions of rays per second of render time.
     pub mrays_per_s: f64,

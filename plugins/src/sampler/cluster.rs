@@ -180,9 +180,8 @@ pub struct ClusterSampler {
     remaining: u64,
     queue: BucketQueue,
     version: Vec<u32>,
-    /// The clusters sampled in the round under way.
-    round_clusters: Vec<u32>,
-    /// The cell and in-cell offsets of each point of the round under way, in batch order.
+    /// The cell and in-cell offsets of each point of the round being planned (or of the
+    /// first stage's batch being observed), in batch order.
     round_cells: Vec<(u32, [f32; MAX_DIMS])>,
     /// Rounds planned and not yet observed, oldest first: their points' cells and clusters.
     in_flight: std::collections::VecDeque<Round>,
@@ -240,7 +239,6 @@ impl ClusterSampler {
             pixel_count: vec![0; pixels as usize],
             queue: BucketQueue::new(),
             version: Vec::new(),
-            round_clusters: Vec::new(),
             round_cells: Vec::new(),
             in_flight: Default::default(),
             spare: Vec::new(),
@@ -349,9 +347,8 @@ impl ClusterSampler {
         let target = (self.remaining / 16)
             .clamp(MIN_ROUND, BATCH_SAMPLES)
             .min(self.remaining);
-        if let Some((cells, clusters)) = self.spare.pop() {
-            (self.round_cells, self.round_clusters) = (cells, clusters);
-        }
+        let (cells, mut clusters) = self.spare.pop().unwrap_or_default();
+        self.round_cells = cells;
         let mut picks: Vec<(u32, u64)> = Vec::new();
         let mut planned_total = 0;
         let mut deferred = Vec::new();
@@ -409,13 +406,10 @@ impl ClusterSampler {
             let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
             self.draw_cells(&picks, &mut rng, out);
         }
-        self.round_clusters.clear();
-        self.round_clusters.extend(picks.iter().map(|&(id, _)| id));
-        let round = (
-            std::mem::take(&mut self.round_cells),
-            std::mem::take(&mut self.round_clusters),
-        );
-        self.in_flight.push_back(round);
+        clusters.clear();
+        clusters.extend(picks.iter().map(|&(id, _)| id));
+        let cells = std::mem::take(&mut self.round_cells);
+        self.in_flight.push_back((cells, clusters));
         self.remaining -= planned_total;
         self.rounds += 1;
     }
