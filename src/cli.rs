@@ -2,12 +2,14 @@
 
 use crate::aov::{parse_aovs, write_aov, AovRequest};
 use crate::image_io::{write_image, RgbImage};
+use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
 use crate::render::{render, MAX_SPP};
-use crate::replay::Recording;
+use crate::replay::{Recording, Replay};
 use crate::scene::Scene;
 use crate::stats::{peak_rss_mb, Seconds, Stats};
-use acr_plugins::{Sampler, Setting};
+use acr_parser::SceneDescription;
+use acr_plugins::{Film, SamplePoint, Sampler, Setting};
 use clap::{Parser, Subcommand};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -99,10 +101,11 @@ pub struct RenderArgs {
     /// Write run statistics as JSON to this file.
     #[arg(long)]
     pub stats: Option<PathBuf>,
-    /// Also measure what the sampler adds to the render's wall time: its batches are traced
-    /// again by a sampler that only replays them (same image, checked), and the stats give
-    /// both times and the sampler's share. Holds every point in memory (32 bytes each).
-    #[arg(long)]
+    /// Also measure what the sampler adds to the render's wall time: after the render, its
+    /// batches are traced again by a sampler that only replays them, alternating with renders
+    /// by a fresh sampler (same image, checked; three of each), and the stats give the median
+    /// times and the sampler's share. Holds every point in memory (32 bytes each).
+    #[arg(long, conflicts_with = "time_limit")]
     pub sampler_cost: bool,
     /// No progress bar and no summary line.
     #[arg(long, short = 'q')]
@@ -149,6 +152,105 @@ fn output_path(args: &RenderArgs, film_filename: Option<&str>) -> PathBuf {
         Some(name) if !name.is_empty() => PathBuf::from(name),
         _ => args.scene.with_extension("exr"),
     }
+}
+
+/// What `--sampler-cost` measured: times of the render loop alone, medians over
+/// [`SamplerCostRun::PAIRS`] runs each.
+#[derive(Clone, Copy, Debug)]
+struct SamplerCost {
+    /// The render again, by a fresh sampler of the same choice.
+    render: f64,
+    /// The recorded batches replayed by a sampler doing no work.
+    replay: f64,
+    /// The median over pairs of (render - replay) / render, each pair run back to back: the
+    /// machine's drift cancels within a pair.
+    share: f64,
+}
+
+/// What `--sampler-cost` needs to render the scene again, and the first render's film.
+struct SamplerCostRun<'a> {
+    desc: &'a SceneDescription,
+    scene: &'a Scene,
+    overrides: &'a Overrides,
+    args: &'a RenderArgs,
+    film: &'a Film,
+}
+
+impl SamplerCostRun<'_> {
+    /// Replays and fresh renders, alternating: single runs on this noisy a machine differ by
+    /// tens of percent.
+    const PAIRS: usize = 3;
+
+    /// Times replays of `batches` and fresh renders alike, after the first render (which
+    /// recorded them) warmed what any render warms: lazily built light distributions, the
+    /// thread pool, the caches (against that first render, a replay ran 10% faster with the
+    /// random sampler, which does next to nothing). Every sampler and film is kept to the end,
+    /// so that each fresh sampler's memory comes fresh from the system, its page faults paid
+    /// as in the first render. Every image is checked to be the first's.
+    fn measure(&self, batches: Vec<Vec<SamplePoint>>) -> Result<SamplerCost, String> {
+        let mut scratch = Vec::new();
+        let (mut renders, mut replays, mut kept) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..Self::PAIRS {
+            let mut plugins = choose_for_scene(
+                self.desc,
+                self.scene,
+                self.overrides,
+                self.args.spp,
+                self.args.seed,
+                &mut scratch,
+            )
+            .map_err(|e| e.to_string())?;
+            let mut replay = Replay::new(plugins.sampler.spp(), &batches);
+            let mut films = [plugins.film(self.scene), plugins.film(self.scene)];
+            let [replayed, rendered] = &mut films;
+            let integrator = &plugins.integrator;
+            replays.push(self.time(integrator, replayed, &mut replay, "the replayed batches")?);
+            let sampler = plugins.sampler.as_mut();
+            renders.push(self.time(integrator, rendered, sampler, "a second render")?);
+            kept.push((plugins, films));
+        }
+        let mut shares: Vec<f64> = renders
+            .iter()
+            .zip(&replays)
+            .map(|(r, p)| (r - p) / r.max(1e-9))
+            .collect();
+        Ok(SamplerCost {
+            render: median(&mut renders),
+            replay: median(&mut replays),
+            share: median(&mut shares).max(0.0),
+        })
+    }
+
+    /// The render loop's wall time with `sampler`, its image checked.
+    fn time(
+        &self,
+        integrator: &Integrator,
+        film: &mut Film,
+        sampler: &mut dyn Sampler,
+        what: &str,
+    ) -> Result<f64, String> {
+        let t = Instant::now();
+        render(
+            self.scene,
+            integrator,
+            sampler,
+            film,
+            self.args.seed,
+            None,
+            None,
+        );
+        let s = t.elapsed().as_secs_f64();
+        if film.pixels() != self.film.pixels() {
+            return Err(format!("--sampler-cost: {what} gave another image"));
+        }
+        Ok(s)
+    }
+}
+
+/// The median of `v` (not empty).
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
 
 fn render_command(args: &RenderArgs) -> Result<(), String> {
@@ -239,8 +341,6 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     } else {
         recording.inner()
     };
-    // The share compares the two render loops alone, timed alike.
-    let t_loop = Instant::now();
     let counts = render(
         &scene,
         &plugins.integrator,
@@ -250,29 +350,19 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         args.time_limit.map(std::time::Duration::from_secs_f64),
         bar.as_ref(),
     );
-    let loop_s = t_loop.elapsed().as_secs_f64();
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     let t_rendered = Instant::now();
-    let replay_s = if args.sampler_cost {
-        let mut replay = recording.replay();
-        let mut again = plugins.film(&scene);
-        let t = Instant::now();
-        render(
-            &scene,
-            &plugins.integrator,
-            &mut replay,
-            &mut again,
-            args.seed,
-            None,
-            None,
-        );
-        let replay_s = t.elapsed().as_secs_f64();
-        if again.pixels() != film.pixels() {
-            return Err("--sampler-cost: the replayed batches gave another image".into());
-        }
-        Some(replay_s)
+    let cost = if args.sampler_cost {
+        let run = SamplerCostRun {
+            desc: &desc,
+            scene: &scene,
+            overrides: &overrides,
+            args,
+            film: &film,
+        };
+        Some(run.measure(recording.into_batches())?)
     } else {
         None
     };
@@ -325,7 +415,8 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             build: (t_built - t_parsed).as_secs_f64(),
             render: render_s,
             sampler: counts.sampler_seconds,
-            replay: replay_s,
+            replay: cost.map(|c| c.replay),
+            rerender: cost.map(|c| c.render),
             reconstruct: (t_reconstructed - t_rendered).as_secs_f64(),
             write: (t_written - t_reconstructed).as_secs_f64(),
             total: t_start.elapsed().as_secs_f64(),
@@ -335,7 +426,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         } else {
             0.0
         },
-        sampler_share: replay_s.map(|r| ((loop_s - r) / loop_s.max(1e-9)).max(0.0)),
+        sampler_share: cost.map(|c| c.share),
         peak_rss_mb: peak_rss_mb(),
     };
     if let Some(path) = &args.stats {

@@ -1,10 +1,9 @@
 //! What a sampler adds to a render's wall time (`acr render --sampler-cost`): its batches are
 //! recorded, then traced again in the same order by a sampler that only gives them back. The
-//! image is the same; the difference in wall time is the sampler's, whether or not its work
-//! overlapped tracing.
+//! image is the same; the difference in wall time from a render by the sampler itself is the
+//! sampler's, whether or not its work overlapped tracing.
 
 use acr_plugins::{SamplePoint, Sampler};
-use std::collections::VecDeque;
 
 /// Records the batches of the sampler it wraps (every point of the render: 32 bytes each).
 pub struct Recording<'a> {
@@ -26,12 +25,9 @@ impl<'a> Recording<'a> {
         &mut *self.inner
     }
 
-    /// A sampler that gives the recorded batches again.
-    pub fn replay(self) -> Replay {
-        Replay {
-            spp: self.inner.spp(),
-            batches: self.batches.into(),
-        }
+    /// The recorded batches, in the order given.
+    pub fn into_batches(self) -> Vec<Vec<SamplePoint>> {
+        self.batches
     }
 }
 
@@ -65,13 +61,25 @@ impl Sampler for Recording<'_> {
     }
 }
 
-/// Gives recorded batches again, in order, doing no work of its own.
-pub struct Replay {
+/// Gives recorded batches again, in order, doing no work of its own but copying them out.
+pub struct Replay<'a> {
     spp: u32,
-    batches: VecDeque<Vec<SamplePoint>>,
+    batches: &'a [Vec<SamplePoint>],
+    next: usize,
 }
 
-impl Sampler for Replay {
+impl<'a> Replay<'a> {
+    /// Gives `batches` again, for a render of `spp` samples per pixel.
+    pub fn new(spp: u32, batches: &'a [Vec<SamplePoint>]) -> Self {
+        Self {
+            spp,
+            batches,
+            next: 0,
+        }
+    }
+}
+
+impl Sampler for Replay<'_> {
     fn name(&self) -> &'static str {
         "replay"
     }
@@ -81,16 +89,13 @@ impl Sampler for Replay {
     }
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        match self.batches.pop_front() {
-            Some(b) => {
-                *out = b;
-                true
-            }
-            None => {
-                out.clear();
-                false
-            }
-        }
+        out.clear();
+        let Some(b) = self.batches.get(self.next) else {
+            return false;
+        };
+        out.extend_from_slice(b);
+        self.next += 1;
+        true
     }
 
     fn halt(&mut self) {

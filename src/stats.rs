@@ -15,8 +15,12 @@ pub struct Seconds {
     /// them). A sampler that plans ahead is called while tracing goes on, and threads waiting
     /// in its calls take up tracing: then this is more than it adds (see `sampler_share`).
     pub sampler: f64,
-    /// With `--sampler-cost`: the render again, its batches replayed by a sampler doing no work.
+    /// With `--sampler-cost`: the render again, its batches replayed by a sampler doing no work
+    /// (the render loop alone, median of three).
     pub replay: Option<f64>,
+    /// With `--sampler-cost`: the render again, by a fresh sampler (the render loop alone,
+    /// median of three, alternating with the replays).
+    pub rerender: Option<f64>,
     /// Reconstructing the image from the film.
     pub reconstruct: f64,
     /// Writing output files.
@@ -67,8 +71,8 @@ pub struct Stats {
     pub dropped_samples: u64,
     /// Time per phase.
     pub seconds: Seconds,
-    /// With `--sampler-cost`: the share of the render's wall time the sampler added,
-    /// (render - replay) / render, both the render loop alone.
+    /// With `--sampler-cost`: the share of the render's wall time the sampler added, the
+    /// median over three back-to-back pairs of (rerender - replay) / rerender (0 if negative).
     pub sampler_share: Option<f64>,
     /// Millions of rays per second of render time.
     pub mrays_per_s: f64,

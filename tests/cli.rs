@@ -877,6 +877,11 @@ fn unknown_plugins_and_parameters_are_located_errors_with_the_closest_name() {
         (&["--aov", "sp=a.png"], &["unknown AOV", "\"spp\""]),
         (&["--time-limit", "0"], &["positive number of seconds"]),
         (&["--time-limit", "nan"], &["positive number of seconds"]),
+        // The renders that measure the sampler's cost cannot stop where the first one did.
+        (
+            &["--time-limit", "1", "--sampler-cost"],
+            &["--sampler-cost", "--time-limit"],
+        ),
     ];
     for (args, words) in cases {
         let o = run(args);
@@ -1045,12 +1050,17 @@ fn sampler_cost_replays_the_render_and_reports_the_sampler_s_share() {
         render_ok(&scene, &plain, &args);
         let cost = ["--sampler-cost", "--stats", stats.to_str().unwrap()];
         render_ok(&scene, &measured, &[&args[..], &cost[..]].concat());
-        // Recording the batches changes nothing; the replay was checked to give this image.
+        // Recording the batches changes nothing; the replays and the renders again were
+        // checked to give this image.
         assert!(std::fs::read(&plain).unwrap() == std::fs::read(&measured).unwrap());
         let s = read_stats(&stats);
         let replay = s["seconds"]["replay"].as_f64().unwrap();
+        let rerender = s["seconds"]["rerender"].as_f64().unwrap();
         let share = s["sampler_share"].as_f64().unwrap();
-        assert!(replay > 0.0, "{sampler}: replay {replay}");
+        assert!(
+            replay > 0.0 && rerender > 0.0,
+            "{sampler}: {replay} {rerender}"
+        );
         assert!((0.0..1.0).contains(&share), "{sampler}: share {share}");
     }
     // Without the flag, neither is reported.
@@ -1061,7 +1071,10 @@ fn sampler_cost_replays_the_render_and_reports_the_sampler_s_share() {
         &["--spp", "1", "--stats", stats.to_str().unwrap()],
     );
     let s = read_stats(&stats);
-    assert!(s["seconds"]["replay"].is_null() && s["sampler_share"].is_null());
+    for key in ["replay", "rerender"] {
+        assert!(s["seconds"][key].is_null(), "{key}");
+    }
+    assert!(s["sampler_share"].is_null());
 }
 
 #[test]

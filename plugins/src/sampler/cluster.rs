@@ -9,7 +9,8 @@
 
 use super::sobol::Scramble;
 use super::{
-    mix64, Pcg32, Sampler, SamplerBuild, SamplerReport, SamplerSetup, SobolSampler, BATCH_SAMPLES,
+    mix64, Pcg32, PixelPattern, Sampler, SamplerBuild, SamplerReport, SamplerSetup, SobolSampler,
+    BATCH_SAMPLES,
 };
 use crate::cluster::build::{initial_clustering, ClusterParams};
 use crate::cluster::clusters::UNASSIGNED;
@@ -813,7 +814,13 @@ impl Sampler for ClusterSampler {
     }
 
     fn plans_ahead(&self) -> bool {
-        self.phase == Phase::Adaptive
+        match self.phase {
+            // The first stage's points depend on nothing observed, but the call after its
+            // last batch makes the first clustering, which needs every batch observed.
+            Phase::Init => self.init.cursor().has_next(),
+            Phase::Adaptive => true,
+            Phase::Done => false,
+        }
     }
 
     fn partition(&self) -> Option<&Partition> {
@@ -1026,6 +1033,68 @@ mod tests {
         assert!(s.rounds > 2, "{} rounds", s.rounds);
         // The partition given is the one of the final clusters, made after the last round.
         assert_eq!(s.partition(), s.make_partition().as_ref());
+    }
+
+    /// Asks the cluster sampler for batches as the render loop does, watching the first stage.
+    struct WatchFirstStage<'a> {
+        s: &'a mut ClusterSampler,
+        /// Batches of the first stage given while one was still unobserved.
+        given_ahead: usize,
+        /// Samples in the cells when the first clustering was made.
+        at_clustering: Option<u64>,
+    }
+
+    impl Sampler for WatchFirstStage<'_> {
+        fn name(&self) -> &'static str {
+            "watch"
+        }
+
+        fn spp(&self) -> u32 {
+            self.s.spp()
+        }
+
+        fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
+            let in_first_stage = self.s.phase == Phase::Init;
+            let more = self.s.next_batch(out);
+            if in_first_stage && self.s.clustering.is_some() && self.at_clustering.is_none() {
+                let counts = &self.s.sums.count;
+                self.at_clustering = Some(counts.iter().map(|&n| u64::from(n)).sum());
+            } else if in_first_stage && self.s.phase == Phase::Init && self.s.plans_ahead() {
+                self.given_ahead += 1;
+            }
+            more
+        }
+
+        fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+            self.s.observe(batch, radiance);
+        }
+
+        fn halt(&mut self) {
+            self.s.halt();
+        }
+
+        fn plans_ahead(&self) -> bool {
+            self.s.plans_ahead()
+        }
+    }
+
+    #[test]
+    fn the_first_stage_is_planned_ahead_and_clustered_once_every_batch_is_observed() {
+        // 256x192 pixels at 2 spp in the first stage: four batches, two per pass. The first
+        // three are given before the one before them is observed; the call after the last
+        // clusters, so it must come after the last is observed.
+        let (w, h) = (256, 192);
+        let mut s = ClusterSampler::new(space(0, 0, w, h, ALL_DIMS[2]), ClusterSettings::new(8), 5);
+        let first_stage = u64::from(w * h * s.settings().init_spp);
+        let mut watch = WatchFirstStage {
+            s: &mut s,
+            given_ahead: 0,
+            at_clustering: None,
+        };
+        let all = super::super::drive(&mut watch, |b| b.iter().map(field).collect(), None);
+        assert_eq!(all.len() as u64, u64::from(w * h * 8));
+        assert_eq!(watch.given_ahead, 3);
+        assert_eq!(watch.at_clustering, Some(first_stage));
     }
 
     fn field(q: &SamplePoint) -> [f32; 3] {

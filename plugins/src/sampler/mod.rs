@@ -210,6 +210,11 @@ impl PixelCursor {
         self.spp
     }
 
+    /// Whether [`Self::next`] has another batch to give.
+    pub(crate) fn has_next(&self) -> bool {
+        self.space.pixels() > 0 && self.pass_start < self.spp
+    }
+
     /// The next batch: row-major pixel indices and the sample indices each of them gets, or
     /// None when every pixel is done.
     pub(crate) fn next(&mut self) -> Option<(Range<u64>, Range<u32>)> {
