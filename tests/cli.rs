@@ -1061,6 +1061,13 @@ fn sampler_cost_replays_the_render_and_reports_the_sampler_s_share() {
             replay > 0.0 && rerender > 0.0,
             "{sampler}: {replay} {rerender}"
         );
+        // The measure's six renders are not counted as reconstruction (a 64x48 image's
+        // reconstruction takes microseconds, a render milliseconds).
+        let reconstruct = s["seconds"]["reconstruct"].as_f64().unwrap();
+        assert!(
+            reconstruct < rerender,
+            "{sampler}: reconstruct {reconstruct}"
+        );
         assert!((0.0..1.0).contains(&share), "{sampler}: share {share}");
     }
     // Without the flag, neither is reported.
