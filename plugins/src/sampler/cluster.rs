@@ -1016,7 +1016,7 @@ mod tests {
 
     /// Runs `s` to the end on radiance `f`, halting after `halt_after` batches if given.
     fn run(
-        s: &mut ClusterSampler,
+        s: &mut dyn Sampler,
         f: impl Fn(&SamplePoint) -> [f32; 3],
         halt_after: Option<usize>,
     ) -> Vec<SamplePoint> {
@@ -1027,7 +1027,7 @@ mod tests {
     fn planning_ahead_observes_every_round_before_the_partition_is_made() {
         let settings = ClusterSettings::new(8);
         let mut s = ClusterSampler::new(space(0, 0, 128, 96, ALL_DIMS[1]), settings, 3);
-        let all = super::super::drive(&mut s, |b| b.iter().map(field).collect(), None);
+        let all = run(&mut s, field, None);
         assert_eq!(all.len(), 128 * 96 * 8);
         assert!(s.in_flight.is_empty(), "a round was never observed");
         assert!(s.rounds > 2, "{} rounds", s.rounds);
@@ -1091,7 +1091,7 @@ mod tests {
             given_ahead: 0,
             at_clustering: None,
         };
-        let all = super::super::drive(&mut watch, |b| b.iter().map(field).collect(), None);
+        let all = run(&mut watch, field, None);
         assert_eq!(all.len() as u64, u64::from(w * h * 8));
         assert_eq!(watch.given_ahead, 3);
         assert_eq!(watch.at_clustering, Some(first_stage));
