@@ -39,7 +39,30 @@ pub struct Manifest {
     /// The methods; the first is the baseline of every ratio.
     #[serde(rename = "method")]
     pub methods: Vec<Method>,
+    /// Runs that measure the sampler's share of wall time, if any.
+    #[serde(default)]
+    pub sampler_cost: Option<SamplerCostRuns>,
 }
+
+/// The sampler's share of wall time (`acr render --sampler-cost`) of every scene and method,
+/// at some budgets: each run is its own process, and the report gives the median over them,
+/// since one process's share moves with the machine's load.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SamplerCostRuns {
+    /// Samples per pixel to measure at.
+    pub spp: Vec<u32>,
+    /// Processes per scene, method and budget.
+    #[serde(default = "five")]
+    pub runs: u32,
+}
+
+fn five() -> u32 {
+    5
+}
+
+/// Most processes per scene, method and budget in a sampler-cost measure.
+const MAX_COST_RUNS: u32 = 100;
 
 /// Samples per pixel to run at, and whether to run equal-time too.
 #[derive(Clone, Debug, Deserialize)]
@@ -202,6 +225,70 @@ pub struct Measured {
     pub peak_rss_mb: f64,
 }
 
+/// The sampler's share of wall time of one method on one scene at one budget.
+#[derive(Clone, Debug)]
+pub struct CostRow {
+    /// Scene label.
+    pub scene: String,
+    /// Method label.
+    pub method: String,
+    /// The budget.
+    pub spp: u32,
+    /// Each run's figures, or why a run failed.
+    pub outcome: Result<Vec<SamplerCost>, String>,
+}
+
+/// What one `--sampler-cost` run reported.
+#[derive(Clone, Copy, Debug)]
+pub struct SamplerCost {
+    /// Its `sampler_share`.
+    pub share: f64,
+    /// Its `seconds.rerender`: a render by a fresh sampler.
+    pub rerender: f64,
+    /// Its `seconds.replay`: the same points traced without the sampler.
+    pub replay: f64,
+}
+
+/// The median of `v` (the mean of the middle two for an even count); NaN when empty.
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
+
+impl CostRow {
+    /// The median, least and largest share over the runs, and the median rerender and replay
+    /// seconds.
+    fn summary(&self) -> Option<[f64; 5]> {
+        let runs = self.outcome.as_ref().ok()?;
+        let of = |f: fn(&SamplerCost) -> f64| runs.iter().map(f).collect::<Vec<_>>();
+        let shares = of(|r| r.share);
+        Some([
+            median(shares.clone()),
+            shares.iter().copied().fold(f64::INFINITY, f64::min),
+            shares.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            median(of(|r| r.rerender)),
+            median(of(|r| r.replay)),
+        ])
+    }
+}
+
+/// Everything a bench measured.
+#[derive(Clone, Debug)]
+pub struct BenchResults {
+    /// The equal-spp and equal-time runs.
+    pub rows: Vec<Row>,
+    /// The sampler-cost measures.
+    pub costs: Vec<CostRow>,
+}
+
 /// Reads and checks a manifest.
 pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
     let text = std::fs::read_to_string(path)
@@ -226,6 +313,25 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
             "{}: budget {bad} spp is out of range",
             path.display()
         ));
+    }
+    if let Some(c) = &m.sampler_cost {
+        if let Some(&bad) = c
+            .spp
+            .iter()
+            .find(|&&s| s == 0 || s > crate::render::MAX_SPP)
+        {
+            return Err(format!(
+                "{}: sampler_cost budget {bad} spp is out of range",
+                path.display()
+            ));
+        }
+        if c.runs == 0 || c.runs > MAX_COST_RUNS {
+            return Err(format!(
+                "{}: sampler_cost runs {} is out of range (1 to {MAX_COST_RUNS})",
+                path.display(),
+                c.runs
+            ));
+        }
     }
     let mut labels = std::collections::HashSet::new();
     for meth in &m.methods {
@@ -312,6 +418,8 @@ struct RunOutput {
     samples: u64,
     pixels: u64,
     peak_rss_mb: f64,
+    /// With `--sampler-cost`: what it measured.
+    cost: Option<SamplerCost>,
 }
 
 /// Runs `acr render` as a child process.
@@ -325,6 +433,7 @@ fn run_render(
     seed: u64,
     threads: Option<u32>,
     time_limit: Option<f64>,
+    sampler_cost: bool,
 ) -> Result<RunOutput, String> {
     let stats = output.with_extension("json");
     let mut cmd = Command::new(exe);
@@ -357,6 +466,9 @@ fn run_render(
     if let Some(t) = time_limit {
         cmd.arg("--time-limit").arg(format!("{t:.6}"));
     }
+    if sampler_cost {
+        cmd.arg("--sampler-cost");
+    }
     let out = cmd
         .output()
         .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
@@ -373,7 +485,20 @@ fn run_render(
     let v: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| format!("{}: {e}", stats.display()))?;
     let f = |k: &str| v["seconds"][k].as_f64().unwrap_or(0.0);
+    let cost = if sampler_cost {
+        let share = v["sampler_share"]
+            .as_f64()
+            .ok_or_else(|| format!("{}: no sampler_share", stats.display()))?;
+        Some(SamplerCost {
+            share,
+            rerender: f("rerender"),
+            replay: f("replay"),
+        })
+    } else {
+        None
+    };
     Ok(RunOutput {
+        cost,
         seconds: f("render") + f("reconstruct"),
         samples: v["samples"].as_u64().unwrap_or(0),
         pixels: v["width"].as_u64().unwrap_or(0) * v["height"].as_u64().unwrap_or(0),
@@ -415,8 +540,8 @@ fn equal_time_spp(spp: u32, baseline: Option<f64>, own: Option<f64>) -> u32 {
     }
 }
 
-/// Runs the whole manifest; returns the rows (failed runs included).
-pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<Vec<Row>, String> {
+/// Runs the whole manifest; returns what it measured (failed runs included).
+pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResults, String> {
     let m = read_manifest(manifest_path)?;
     let base = manifest_path.parent().unwrap_or(Path::new("."));
     let cache = base.join(m.cache.clone().unwrap_or_else(|| PathBuf::from("cache")));
@@ -521,17 +646,84 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<Vec<Row>, 
             }
         }
     }
+    let costs = measure_costs(&m, base, &runs_dir, opts);
     write_csv(&opts.out.join("results.csv"), &rows)?;
+    if m.sampler_cost.is_some() {
+        write_cost_csv(&opts.out.join("sampler_cost.csv"), &costs)?;
+    }
     for scene in &m.scenes {
         let path = opts.out.join(format!("{}.png", file_safe(&scene.name)));
         if let Err(e) = plot_scene(&path, &scene.name, &m.methods, &rows) {
             eprintln!("{}: plot failed: {e}", path.display());
         }
     }
-    let report = report_markdown(&m, manifest_path, opts, &rows);
+    let report = report_markdown(&m, manifest_path, opts, &rows, &costs);
     let path = opts.out.join("report.md");
     std::fs::write(&path, report).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
-    Ok(rows)
+    Ok(BenchResults { rows, costs })
+}
+
+/// The manifest's sampler-cost measures: every scene, budget and method, `runs` processes
+/// each with `--sampler-cost`; a measure with a failed run is a failed row.
+fn measure_costs(m: &Manifest, base: &Path, runs_dir: &Path, opts: &BenchOptions) -> Vec<CostRow> {
+    let Some(spec) = &m.sampler_cost else {
+        return Vec::new();
+    };
+    let total = m.scenes.len() * spec.spp.len() * m.methods.len();
+    let mut costs = Vec::with_capacity(total);
+    for scene in &m.scenes {
+        let scene_path = base.join(&scene.path);
+        for &spp in &spec.spp {
+            for method in &m.methods {
+                let out = runs_dir.join(format!(
+                    "{}-{}-{spp}-sampler-cost.exr",
+                    file_safe(&scene.name),
+                    file_safe(&method.label)
+                ));
+                let outcome = (0..spec.runs)
+                    .map(|_| {
+                        let r = run_render(
+                            &opts.exe,
+                            &scene_path,
+                            &out,
+                            method,
+                            spp,
+                            m.seed,
+                            m.threads,
+                            None,
+                            true,
+                        )?;
+                        r.cost.ok_or_else(|| "no sampler cost".to_owned())
+                    })
+                    .collect::<Result<Vec<_>, String>>();
+                let row = CostRow {
+                    scene: scene.name.clone(),
+                    method: method.label.clone(),
+                    spp,
+                    outcome,
+                };
+                let head = format!(
+                    "[{}/{total}] {} {} {spp} spp sampler cost",
+                    costs.len() + 1,
+                    scene.name,
+                    method.label
+                );
+                match (row.summary(), &row.outcome) {
+                    (Some([share, lo, hi, ..]), _) => eprintln!(
+                        "{head}: {:.1}% (median of {}; {:.1} to {:.1}%)",
+                        100.0 * share,
+                        spec.runs,
+                        100.0 * lo,
+                        100.0 * hi
+                    ),
+                    (None, Err(e)) => eprintln!("{head}: FAILED: {e}"),
+                    (None, Ok(_)) => {}
+                }
+                costs.push(row);
+            }
+        }
+    }
+    costs
 }
 
 /// One run, measured against the reference.
@@ -548,7 +740,7 @@ fn measure(
     reference: &crate::image_io::RgbImage,
 ) -> Result<Measured, String> {
     let r = run_render(
-        &opts.exe, scene, out, method, spp, seed, threads, time_limit,
+        &opts.exe, scene, out, method, spp, seed, threads, time_limit, false,
     )?;
     let img = read_image(out, false).map_err(|e| format!("{}: {e}", out.display()))?;
     let metrics = compare(&img, reference)?;
@@ -593,7 +785,7 @@ fn reference_image(
                 let t = Instant::now();
                 let tmp = path.with_extension("partial.exr");
                 run_render(
-                    &opts.exe, scene_path, &tmp, meth, *spp, m.seed, m.threads, None,
+                    &opts.exe, scene_path, &tmp, meth, *spp, m.seed, m.threads, None, false,
                 )?;
                 std::fs::rename(&tmp, &path).map_err(|e| format!("{}: {e}", path.display()))?;
                 let _ = std::fs::remove_file(tmp.with_extension("json"));
@@ -665,6 +857,31 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
     std::fs::write(path, s).map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
+/// The sampler-cost CSV: one row per scene, method and budget, with the median share over
+/// its runs, the least and the largest, and the median seconds of a render and of a replay.
+pub fn write_cost_csv(path: &Path, costs: &[CostRow]) -> Result<(), String> {
+    let mut s = String::from(
+        "scene,method,spp,runs,sampler_share,share_min,share_max,rerender_seconds,replay_seconds,status\n",
+    );
+    for c in costs {
+        let head = format!("{},{},{}", csv_field(&c.scene), csv_field(&c.method), c.spp);
+        match (&c.outcome, c.summary()) {
+            (Ok(runs), Some([share, lo, hi, rerender, replay])) => {
+                let _ = writeln!(
+                    s,
+                    "{head},{},{share:.4},{lo:.4},{hi:.4},{rerender:.6},{replay:.6},ok",
+                    runs.len()
+                );
+            }
+            (outcome, _) => {
+                let e = outcome.as_ref().err().map_or("no runs", |e| e.as_str());
+                let _ = writeln!(s, "{head},,,,,,,{}", csv_field(&format!("failed: {e}")));
+            }
+        }
+    }
+    std::fs::write(path, s).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
 /// The equal-spp and equal-time result of `method` on `scene` at `spp`.
 fn find<'a>(rows: &'a [Row], scene: &str, method: &str, spp: u32, mode: Mode) -> Option<&'a Row> {
     rows.iter()
@@ -673,7 +890,13 @@ fn find<'a>(rows: &'a [Row], scene: &str, method: &str, spp: u32, mode: Mode) ->
 
 /// The Markdown report: the setting, then per scene a table of equal-spp and equal-time errors
 /// with their ratios to the first method (below 1: better than the first method).
-pub fn report_markdown(m: &Manifest, manifest: &Path, opts: &BenchOptions, rows: &[Row]) -> String {
+pub fn report_markdown(
+    m: &Manifest,
+    manifest: &Path,
+    opts: &BenchOptions,
+    rows: &[Row],
+    costs: &[CostRow],
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {}\n", m.title.as_deref().unwrap_or("acr bench"));
     let _ = writeln!(s, "- manifest: `{}`", manifest.display());
@@ -745,6 +968,32 @@ pub fn report_markdown(m: &Manifest, manifest: &Path, opts: &BenchOptions, rows:
                 }
                 let _ = writeln!(s, "{line}");
             }
+        }
+        s.push('\n');
+    }
+    if let Some(spec) = &m.sampler_cost {
+        let _ = writeln!(s, "## The sampler's share of wall time\n");
+        let _ = writeln!(
+            s,
+            "`acr render --sampler-cost`, {} processes each (`sampler_cost.csv`): a render by a fresh sampler against a replay of its points, share = (render - replay) / render; the median over the processes, then the least and the largest.\n",
+            spec.runs
+        );
+        let _ = writeln!(
+            s,
+            "| scene | spp | method | share | least | largest | render s | replay s |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+        for c in costs {
+            let figures = match c.summary() {
+                Some([share, lo, hi, rerender, replay]) => format!(
+                    "{:.1}% | {:.1}% | {:.1}% | {rerender:.3} | {replay:.3}",
+                    100.0 * share,
+                    100.0 * lo,
+                    100.0 * hi
+                ),
+                None => "failed | | | |".to_owned(),
+            };
+            let _ = writeln!(s, "| {} | {} | {} | {figures} |", c.scene, c.spp, c.method);
         }
         s.push('\n');
     }
@@ -949,7 +1198,30 @@ mod tests {
         .unwrap();
         let e = read_manifest(&p).unwrap_err();
         assert!(e.contains("names method \"nope\""), "{e}");
+        for (section, message) in [
+            ("spp = [8]\nruns = 0", "sampler_cost runs 0 is out of range"),
+            ("spp = [0]", "sampler_cost budget 0 spp is out of range"),
+        ] {
+            std::fs::write(
+                &p,
+                format!(
+                    "[budgets]\nspp = [1]\n[sampler_cost]\n{section}\n[reference]\n\
+                     sampler = \"sobol\"\nspp = 4\n[[scene]]\nname = \"a\"\npath = \"a.pbrt\"\n\
+                     [[method]]\nlabel = \"x\"\n"
+                ),
+            )
+            .unwrap();
+            let e = read_manifest(&p).unwrap_err();
+            assert!(e.contains(message), "{e}");
+        }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(Vec::new()).is_nan());
     }
 
     #[test]

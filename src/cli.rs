@@ -477,10 +477,21 @@ fn bench_command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
         command,
         commit: crate::bench::commit(),
     };
-    let rows = crate::bench::run_bench(manifest, &opts)?;
+    let results = crate::bench::run_bench(manifest, &opts)?;
+    let rows = &results.rows;
     let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    let costs = &results.costs;
+    let costs_failed = costs.iter().filter(|c| c.outcome.is_err()).count();
+    let cost_note = if costs.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ", {} sampler-cost measures, {costs_failed} failed",
+            costs.len()
+        )
+    };
     eprintln!(
-        "{} runs, {failed} failed -> {}",
+        "{} runs, {failed} failed{cost_note} -> {}",
         rows.len(),
         out.join("report.md").display()
     );

@@ -1236,6 +1236,73 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
 }
 
 #[test]
+fn bench_measures_the_sampler_s_share_of_wall_time_when_asked() {
+    let dir = TempDir::new("bench-cost");
+    dir.write("s.pbrt", &small_scene(""));
+    let manifest = dir.write(
+        "m.toml",
+        "seed = 2\nthreads = 2\n[budgets]\nspp = [2]\nequal_time = false\n\
+         [sampler_cost]\nspp = [2]\nruns = 2\n\
+         [reference]\nsampler = \"sobol\"\nfilter = \"box\"\nspp = 16\n\
+         [[scene]]\nname = \"small\"\npath = \"s.pbrt\"\n\
+         [[method]]\nlabel = \"random+box\"\nsampler = \"random\"\nfilter = \"box\"\n\
+         [[method]]\nlabel = \"cluster+gaussian\"\nsampler = \"cluster\"\nfilter = \"gaussian\"\n\
+         [[method]]\nlabel = \"broken\"\nsampler = \"nosuch\"\n",
+    );
+    let out = dir.join("out");
+    let o = acr([
+        "bench",
+        manifest.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(err.matches("spp sampler cost: ").count(), 3, "{err}");
+    assert!(err.contains("3 sampler-cost measures, 1 failed"), "{err}");
+    let csv = std::fs::read_to_string(out.join("sampler_cost.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        lines[0],
+        "scene,method,spp,runs,sampler_share,share_min,share_max,rerender_seconds,replay_seconds,status"
+    );
+    assert_eq!(lines.len(), 4, "{csv}");
+    for m in ["random+box", "cluster+gaussian"] {
+        let l = lines
+            .iter()
+            .find(|l| l.starts_with(&format!("small,{m},2,")))
+            .unwrap_or_else(|| panic!("{m}: {csv}"));
+        assert!(l.ends_with(",ok"), "{l}");
+        let f = |i: usize| l.split(',').nth(i).unwrap().parse::<f64>().unwrap();
+        assert_eq!(f(3), 2.0, "{l}");
+        let (share, lo, hi) = (f(4), f(5), f(6));
+        assert!(
+            (0.0..1.0).contains(&share) && lo <= share && share <= hi,
+            "{l}"
+        );
+        assert!(f(7) > 0.0 && f(8) > 0.0, "{l}");
+    }
+    let broken = lines.iter().find(|l| l.contains("broken")).unwrap();
+    assert!(
+        broken.contains("failed:") && broken.contains("nosuch"),
+        "{broken}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("## The sampler's share of wall time"),
+        "{report}"
+    );
+    assert!(
+        report.contains("| small | 2 | cluster+gaussian | "),
+        "{report}"
+    );
+    assert!(
+        report.contains("| small | 2 | broken | failed |"),
+        "{report}"
+    );
+}
+
+#[test]
 fn the_polynomial_filter_reconstructs_after_any_sampler_and_reports_its_fits() {
     let dir = TempDir::new("polynomial");
     let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 40, 30));
