@@ -1162,6 +1162,18 @@ fn the_cluster_sampler_reports_clusters_and_draws_them() {
     );
 }
 
+/// Runs `acr bench MANIFEST --out OUT`, which must succeed; its stderr.
+fn bench_ok(manifest: &Path, out: &Path) -> String {
+    let o = acr([
+        "bench",
+        manifest.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stderr(&o)
+}
+
 #[test]
 fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     let dir = TempDir::new("bench");
@@ -1177,16 +1189,7 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
          [[method]]\nlabel = \"broken\"\nsampler = \"nosuch\"\n",
     );
     let out = dir.join("out");
-    let run = || {
-        let o = acr([
-            "bench",
-            manifest.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        stderr(&o)
-    };
+    let run = || bench_ok(&manifest, &out);
     let err = run();
     assert!(err.contains("rendering the reference"), "{err}");
     // A progress line per run: 2 budgets x (3 equal-spp + 2 equal-time).
@@ -1250,14 +1253,7 @@ fn bench_measures_the_sampler_s_share_of_wall_time_when_asked() {
          [[method]]\nlabel = \"broken\"\nsampler = \"nosuch\"\n",
     );
     let out = dir.join("out");
-    let o = acr([
-        "bench",
-        manifest.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
+    let err = bench_ok(&manifest, &out);
     assert_eq!(err.matches("spp sampler cost: ").count(), 3, "{err}");
     assert!(err.contains("3 sampler-cost measures, 1 failed"), "{err}");
     let csv = std::fs::read_to_string(out.join("sampler_cost.csv")).unwrap();
