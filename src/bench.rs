@@ -6,6 +6,7 @@
 
 use crate::image_io::read_image;
 use crate::metrics::{compare, Metrics};
+use crate::stats::median;
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -249,34 +250,36 @@ pub struct SamplerCost {
     pub replay: f64,
 }
 
-/// The median of `v` (the mean of the middle two for an even count); NaN when empty.
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
+/// A sampler-cost measure over its runs.
+#[derive(Clone, Copy, Debug)]
+struct CostSummary {
+    runs: usize,
+    /// The median share.
+    share: f64,
+    least: f64,
+    largest: f64,
+    /// The median seconds of a render by a fresh sampler.
+    rerender: f64,
+    /// The median seconds of a replay.
+    replay: f64,
 }
 
 impl CostRow {
-    /// The median, least and largest share over the runs, and the median rerender and replay
-    /// seconds.
-    fn summary(&self) -> Option<[f64; 5]> {
-        let runs = self.outcome.as_ref().ok()?;
+    /// Its runs summed up, or why one failed.
+    fn summary(&self) -> Result<CostSummary, &str> {
+        let runs = self.outcome.as_deref().map_err(String::as_str)?;
         let of = |f: fn(&SamplerCost) -> f64| runs.iter().map(f).collect::<Vec<_>>();
-        let shares = of(|r| r.share);
-        Some([
-            median(shares.clone()),
-            shares.iter().copied().fold(f64::INFINITY, f64::min),
-            shares.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            median(of(|r| r.rerender)),
-            median(of(|r| r.replay)),
-        ])
+        let mut shares = of(|r| r.share);
+        let share = median(&mut shares);
+        Ok(CostSummary {
+            runs: runs.len(),
+            share,
+            // Sorted by the median.
+            least: shares.first().copied().unwrap_or(f64::NAN),
+            largest: shares.last().copied().unwrap_or(f64::NAN),
+            rerender: median(&mut of(|r| r.rerender)),
+            replay: median(&mut of(|r| r.replay)),
+        })
     }
 }
 
@@ -708,16 +711,15 @@ fn measure_costs(m: &Manifest, base: &Path, runs_dir: &Path, opts: &BenchOptions
                     scene.name,
                     method.label
                 );
-                match (row.summary(), &row.outcome) {
-                    (Some([share, lo, hi, ..]), _) => eprintln!(
+                match row.summary() {
+                    Ok(c) => eprintln!(
                         "{head}: {:.1}% (median of {}; {:.1} to {:.1}%)",
-                        100.0 * share,
-                        spec.runs,
-                        100.0 * lo,
-                        100.0 * hi
+                        100.0 * c.share,
+                        c.runs,
+                        100.0 * c.least,
+                        100.0 * c.largest
                     ),
-                    (None, Err(e)) => eprintln!("{head}: FAILED: {e}"),
-                    (None, Ok(_)) => {}
+                    Err(e) => eprintln!("{head}: FAILED: {e}"),
                 }
                 costs.push(row);
             }
@@ -865,16 +867,15 @@ pub fn write_cost_csv(path: &Path, costs: &[CostRow]) -> Result<(), String> {
     );
     for c in costs {
         let head = format!("{},{},{}", csv_field(&c.scene), csv_field(&c.method), c.spp);
-        match (&c.outcome, c.summary()) {
-            (Ok(runs), Some([share, lo, hi, rerender, replay])) => {
+        match c.summary() {
+            Ok(c) => {
                 let _ = writeln!(
                     s,
-                    "{head},{},{share:.4},{lo:.4},{hi:.4},{rerender:.6},{replay:.6},ok",
-                    runs.len()
+                    "{head},{},{:.4},{:.4},{:.4},{:.6},{:.6},ok",
+                    c.runs, c.share, c.least, c.largest, c.rerender, c.replay
                 );
             }
-            (outcome, _) => {
-                let e = outcome.as_ref().err().map_or("no runs", |e| e.as_str());
+            Err(e) => {
                 let _ = writeln!(s, "{head},,,,,,,{}", csv_field(&format!("failed: {e}")));
             }
         }
@@ -985,13 +986,15 @@ pub fn report_markdown(
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
         for c in costs {
             let figures = match c.summary() {
-                Some([share, lo, hi, rerender, replay]) => format!(
-                    "{:.1}% | {:.1}% | {:.1}% | {rerender:.3} | {replay:.3}",
-                    100.0 * share,
-                    100.0 * lo,
-                    100.0 * hi
+                Ok(c) => format!(
+                    "{:.1}% | {:.1}% | {:.1}% | {:.3} | {:.3}",
+                    100.0 * c.share,
+                    100.0 * c.least,
+                    100.0 * c.largest,
+                    c.rerender,
+                    c.replay
                 ),
-                None => "failed | | | |".to_owned(),
+                Err(_) => "failed | | | |".to_owned(),
             };
             let _ = writeln!(s, "| {} | {} | {} | {figures} |", c.scene, c.spp, c.method);
         }
@@ -1215,13 +1218,6 @@ mod tests {
             assert!(e.contains(message), "{e}");
         }
         let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    #[test]
-    fn median_of_odd_and_even_counts() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert!(median(Vec::new()).is_nan());
     }
 
     #[test]

@@ -7,7 +7,7 @@ use crate::registry::{choose_for_scene, Overrides};
 use crate::render::{render, MAX_SPP};
 use crate::replay::{Recording, Replay};
 use crate::scene::Scene;
-use crate::stats::{peak_rss_mb, Seconds, Stats};
+use crate::stats::{median, peak_rss_mb, Seconds, Stats};
 use acr_parser::SceneDescription;
 use acr_plugins::{Film, SamplePoint, Sampler, Setting};
 use clap::{Parser, Subcommand};
@@ -245,12 +245,6 @@ impl SamplerCostRun<'_> {
         }
         Ok(s)
     }
-}
-
-/// The median of `v` (not empty).
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn render_command(args: &RenderArgs) -> Result<(), String> {
