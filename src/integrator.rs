@@ -7,6 +7,7 @@
 //! expectation, one ray fewer per bounce.
 
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction};
+use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::sampling::power_heuristic;
 use crate::scene::Scene;
@@ -83,8 +84,8 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
                 ParamSpec::new(
                     "lightsamplestrategy",
                     ParamType::String,
-                    "spatial",
-                    "how a light is chosen: uniform, power or spatial",
+                    "bvh",
+                    "how a light is chosen: bvh (pbrt-v4's light BVH), spatial (pbrt-v3's default), power or uniform",
                 ),
             ],
         },
@@ -127,11 +128,11 @@ impl Integrator {
     /// `path` from its parameters (pbrt-v3's defaults: maxdepth 5, rrthreshold 1).
     pub fn path(c: &Choice) -> Result<Self> {
         let params = &c.params;
-        let name = params.string("lightsamplestrategy")?.unwrap_or("spatial");
+        let name = params.string("lightsamplestrategy")?.unwrap_or("bvh");
         let Some(light_strategy) = LightStrategy::from_name(name) else {
             let p = params.get("lightsamplestrategy");
             let message =
-                format!("lightsamplestrategy \"{name}\" is not uniform, power or spatial");
+                format!("lightsamplestrategy \"{name}\" is not bvh, spatial, power or uniform");
             return Err(match p {
                 Some(p) => Error::at(&p.loc, message),
                 None => Error::file("lightsamplestrategy", message),
@@ -246,9 +247,9 @@ fn path_li(
     // The previous scattering point and the BSDF density of the direction taken from it.
     let mut prev_p = ray.o;
     let mut prev_bsdf_pdf = 0.0f32;
-    // The light distribution at the previous scattering point, for the MIS weight of emission
-    // that the BSDF sample finds.
-    let mut prev_choice: Option<&crate::lightdistrib::LightPmf> = None;
+    // Where the light for next-event estimation was chosen at the previous scattering point,
+    // for the MIS weight of emission that the BSDF sample finds (`None`: none was chosen).
+    let mut prev_ctx: Option<LightContext> = None;
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
     loop {
@@ -260,7 +261,9 @@ fn path_li(
                 if depth == 0 || specular_bounce {
                     l += beta * le;
                 } else {
-                    let choice = prev_choice.map_or(0.0, |d| d.pdf(i as usize));
+                    let choice = prev_ctx.map_or(0.0, |ctx| {
+                        scene.light_choice_pdf(light_strategy, ctx, i as usize)
+                    });
                     let light_pdf = choice * light.pdf_le(ray.d.normalize());
                     l += beta * le * power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
                 }
@@ -275,7 +278,9 @@ fn path_li(
                 if depth == 0 || specular_bounce {
                     l += beta * le;
                 } else {
-                    let choice = prev_choice.map_or(0.0, |d| d.pdf(li as usize));
+                    let choice = prev_ctx.map_or(0.0, |ctx| {
+                        scene.light_choice_pdf(light_strategy, ctx, li as usize)
+                    });
                     let light_pdf =
                         choice * light.pdf_area_hit(&scene.accel.world, prev_p, si.p, si.n);
                     l += beta * le * power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
@@ -295,20 +300,32 @@ fn path_li(
             break;
         }
         let bsdf = scene.materials[material as usize].bsdf(&si);
+        prev_ctx = None;
         if have_lights && bsdf.has_non_specular() {
-            let choice = scene.light_choice(light_strategy, si.p);
-            prev_choice = Some(choice);
-            let (light_index, choice_pdf) = choice.sample(stream.next_1d());
-            l += beta
-                * sample_light(
-                    scene,
-                    &si,
-                    &bsdf,
-                    light_index as u32,
-                    choice_pdf,
-                    stream,
-                    &mut rays,
-                );
+            let ctx = LightContext {
+                p: si.p,
+                n: si.shading_n,
+            };
+            prev_ctx = Some(ctx);
+            match scene.choose_light(light_strategy, ctx, stream.next_1d()) {
+                Some((light_index, choice_pdf)) => {
+                    l += beta
+                        * sample_light(
+                            scene,
+                            &si,
+                            &bsdf,
+                            light_index as u32,
+                            choice_pdf,
+                            stream,
+                            &mut rays,
+                        );
+                }
+                // No light can reach the point: the light sample's dimensions are spent all
+                // the same, so that later decisions keep their place in the stream.
+                None => {
+                    stream.next_2d();
+                }
+            }
         }
         let u_lobe = stream.next_1d();
         let u = stream.next_2d();
@@ -398,9 +415,15 @@ fn direct_li(
                 }
             }
             DirectStrategy::One => {
-                let choice = scene.light_choice(LightStrategy::Uniform, si.p);
-                let (i, pdf) = choice.sample(stream.next_1d());
-                l += estimate_direct(scene, &si, &bsdf, i as u32, pdf, stream, rays);
+                let ctx = LightContext {
+                    p: si.p,
+                    n: si.shading_n,
+                };
+                if let Some((i, pdf)) =
+                    scene.choose_light(LightStrategy::Uniform, ctx, stream.next_1d())
+                {
+                    l += estimate_direct(scene, &si, &bsdf, i as u32, pdf, stream, rays);
+                }
             }
         }
     }

@@ -12,6 +12,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
+pub mod lightbvh;
 pub mod lightdistrib;
 pub mod material;
 pub mod metrics;

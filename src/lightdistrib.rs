@@ -17,6 +17,8 @@ pub enum LightStrategy {
     Power,
     /// In proportion to an estimate of the light's contribution near the shading point.
     Spatial,
+    /// pbrt-v4's light BVH: by bounds on each group of lights' contribution at the point.
+    Bvh,
 }
 
 impl LightStrategy {
@@ -26,6 +28,7 @@ impl LightStrategy {
             "uniform" => Some(Self::Uniform),
             "power" => Some(Self::Power),
             "spatial" => Some(Self::Spatial),
+            "bvh" => Some(Self::Bvh),
             _ => None,
         }
     }

@@ -6,6 +6,7 @@ use crate::camera::Camera;
 use crate::film::FilmSettings;
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3};
 use crate::light::{prim_area, spot_frame, AreaShape, EnvMap, Light};
+use crate::lightbvh::{LightBvh, LightContext};
 use crate::lightdistrib::{LightDistribution, LightPmf, LightStrategy};
 use crate::material::Material;
 use crate::shapes::{Cylinder, Disk, Sphere, Transform, TriangleMesh};
@@ -87,13 +88,53 @@ impl Scene {
         self.accel.occluded(&ray, t_max)
     }
 
-    /// The distribution to choose a light from at `p` under `strategy`.
+    /// Chooses a light for next-event estimation at `ctx` under `strategy` with `u` in
+    /// [0, 1): its index and probability; `None` when the strategy finds no light that can
+    /// reach the point.
     #[inline]
-    pub fn light_choice(&self, strategy: LightStrategy, p: Vec3) -> &LightPmf {
+    pub fn choose_light(
+        &self,
+        strategy: LightStrategy,
+        ctx: LightContext,
+        u: f32,
+    ) -> Option<(usize, f32)> {
+        match strategy {
+            LightStrategy::Bvh => self.light_bvh().sample(ctx, u),
+            _ => {
+                let pmf = self.light_pmf(strategy, ctx.p);
+                (!pmf.is_empty()).then(|| pmf.sample(u))
+            }
+        }
+    }
+
+    /// Probability that [`Scene::choose_light`] at `ctx` under `strategy` picks `light`.
+    #[inline]
+    pub fn light_choice_pdf(
+        &self,
+        strategy: LightStrategy,
+        ctx: LightContext,
+        light: usize,
+    ) -> f32 {
+        match strategy {
+            LightStrategy::Bvh => self.light_bvh().pmf(ctx, light),
+            _ => self.light_pmf(strategy, ctx.p).pdf(light),
+        }
+    }
+
+    /// The light BVH (built on first use).
+    pub fn light_bvh(&self) -> &LightBvh {
+        self.light_choice
+            .bvh
+            .get_or_init(|| LightBvh::new(&self.lights, &self.accel.world))
+    }
+
+    /// The distribution to choose a light from at `p` under a strategy other than `bvh`.
+    #[inline]
+    fn light_pmf(&self, strategy: LightStrategy, p: Vec3) -> &LightPmf {
         let c = &self.light_choice;
         match strategy {
             LightStrategy::Uniform => &c.uniform,
-            LightStrategy::Power => &c.power,
+            LightStrategy::Power | LightStrategy::Bvh => &c.power,
             LightStrategy::Spatial => c
                 .spatial
                 .get_or_init(|| LightDistribution::new(strategy, &self.lights, c.bounds))
@@ -107,6 +148,7 @@ struct LightChoices {
     uniform: LightPmf,
     power: LightPmf,
     spatial: OnceLock<LightDistribution>,
+    bvh: OnceLock<LightBvh>,
     bounds: (Vec3, Vec3),
 }
 
@@ -690,6 +732,7 @@ impl Scene {
                 uniform: LightPmf::new(&vec![1.0; powers.len()]),
                 power: LightPmf::new(&powers),
                 spatial: OnceLock::new(),
+                bvh: OnceLock::new(),
                 bounds: (lo, hi),
             },
             lights: b.lights,

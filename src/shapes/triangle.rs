@@ -340,7 +340,7 @@ fn triangle_dpduv(p: &[Vec3; 3], uv: &[Vec2; 3]) -> (Vec3, Vec3) {
 /// The interpolated, normalised shading normal at barycentrics `b`, if the mesh has normals and
 /// the interpolation does not vanish.
 #[inline]
-fn shading_normal(mesh: &TriangleMesh, tri: usize, b: [f32; 3]) -> Option<Vec3> {
+pub fn shading_normal(mesh: &TriangleMesh, tri: usize, b: [f32; 3]) -> Option<Vec3> {
     let normals = mesh.normals.as_ref()?;
     let [a, bb, c] = mesh.vertex_indices(tri);
     let ns = b[0] * normals[a] + b[1] * normals[bb] + b[2] * normals[c];
