@@ -1348,3 +1348,80 @@ fn the_polynomial_filter_reconstructs_after_any_sampler_and_reports_its_fits() {
         "degree 5 is out of range",
     );
 }
+
+/// bench/versus.py (acr alone, as without pbrt binaries): it renders the given scene and puts
+/// its table between the markers of the output file, keeping the text around them. Skipped
+/// where there is no python3.
+#[test]
+fn the_comparison_script_writes_its_table_between_the_markers() {
+    if Command::new("python3").arg("--version").output().is_err() {
+        eprintln!("skipped: no python3");
+        return;
+    }
+    let dir = TempDir::new("versus");
+    let scene = dir.write(
+        "tiny.pbrt",
+        "LookAt 0 0 -3  0 0 0  0 1 0\nCamera \"perspective\"\n\
+         Film \"image\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
+         Sampler \"random\" \"integer pixelsamples\" 2\nWorldBegin\n\
+         LightSource \"point\" \"point from\" [0 0 -2]\nShape \"sphere\"\nWorldEnd\n",
+    );
+    let out = dir.write(
+        "report.md",
+        "# before\n<!-- versus:begin -->\nold table\n<!-- versus:end -->\nafter\n",
+    );
+    let run = Command::new("python3")
+        .arg(root().join("bench/versus.py"))
+        .args([
+            "--acr",
+            env!("CARGO_BIN_EXE_acr"),
+            "--threads",
+            "1",
+            "--scene",
+        ])
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.starts_with("# before\n<!-- versus:begin -->\n"),
+        "{text}"
+    );
+    assert!(text.ends_with("<!-- versus:end -->\nafter\n"), "{text}");
+    assert!(!text.contains("old table"), "{text}");
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("| tiny |"))
+        .unwrap_or_else(|| panic!("no row for the scene: {text}"));
+    // | tiny | seconds | peak MiB |: both numbers, the time positive.
+    let cells: Vec<&str> = row.trim_matches('|').split('|').map(str::trim).collect();
+    assert_eq!(cells.len(), 3, "{row}");
+    assert!(cells[1].parse::<f64>().unwrap() > 0.0, "{row}");
+    assert!(cells[2].parse::<f64>().unwrap() > 0.0, "{row}");
+    // A binary that is not there is a clear error, not a table.
+    let bad = Command::new("python3")
+        .arg(root().join("bench/versus.py"))
+        .args([
+            "--acr",
+            env!("CARGO_BIN_EXE_acr"),
+            "--pbrt-v4",
+            "/nonexistent/pbrt",
+        ])
+        .arg("--scene")
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("pbrt-v4 binary /nonexistent/pbrt is not an executable file"),
+        "{err}"
+    );
+}

@@ -1,0 +1,186 @@
+#!/usr/bin/env python3
+"""acr against pbrt-v3 and pbrt-v4: whole-process seconds and peak memory on the same scenes.
+
+Each scene renders at its own resolution and spp (pbrt-v3 has no spp flag, so no renderer gets
+one), with the same thread count, each run its own process; the time is wall clock from start to
+exit and the memory the process's peak resident set (wait4's ru_maxrss). pbrt-v4 renders the
+scene as `pbrt --upgrade` rewrites it (written beside the original, so that relative Include and
+PLY paths resolve, and removed afterwards). A renderer whose binary is not given is left out.
+
+usage: python3 bench/versus.py [--acr PATH] [--pbrt-v3 PATH] [--pbrt-v4 PATH] [--threads N]
+           [--runs N] [--scene FILE ...] [--large DIR] [--out FILE.md]
+Without --scene: scenes/*.pbrt, the pbrt-v3 scenes in ../shared/scenes/pbrt-v3 when present,
+and a 1M-triangle mesh written by bench/tools/make_large_scene.py into --large (default
+bench/cache/large). With --out, the table replaces the text between the markers
+<!-- versus:begin --> and <!-- versus:end --> in that file (appended when they are missing).
+Python 3 standard library only."""
+
+import argparse
+import glob
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEGIN, END = "<!-- versus:begin -->", "<!-- versus:end -->"
+
+
+def run(cmd, cwd=None):
+    """Runs cmd to completion: (seconds, peak RSS in MiB, exit status, stderr tail)."""
+    with tempfile.TemporaryFile() as err:
+        start = time.perf_counter()
+        proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, usage = os.wait4(proc.pid, 0)
+        seconds = time.perf_counter() - start
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        err.seek(0)
+        tail = err.read().decode(errors="replace").strip().splitlines()[-3:]
+    # ru_maxrss is in KiB on Linux.
+    return seconds, usage.ru_maxrss / 1024.0, proc.returncode, " / ".join(tail)
+
+
+def upgraded(pbrt_v4, scene):
+    """The scene rewritten by `pbrt --upgrade`, beside the original; None when that fails."""
+    out = subprocess.run([pbrt_v4, "--upgrade", scene], capture_output=True, text=True)
+    if out.returncode != 0:
+        print(f"  pbrt-v4 --upgrade failed: {out.stderr.strip()[-300:]}", file=sys.stderr)
+        return None
+    path = os.path.join(os.path.dirname(scene), f".versus-v4-{os.path.basename(scene)}")
+    with open(path, "w") as f:
+        f.write(out.stdout)
+    return path
+
+
+def measure(label, cmd, runs, cwd=None):
+    """Median seconds and peak MiB over `runs` runs, or a failure note."""
+    times, peaks = [], []
+    for _ in range(runs):
+        seconds, peak, code, tail = run(cmd, cwd)
+        if code != 0:
+            print(f"  {label} failed ({code}): {tail}", file=sys.stderr)
+            return None
+        times.append(seconds)
+        peaks.append(peak)
+    print(f"  {label}: {statistics.median(times):.2f} s, {max(peaks):.0f} MiB", file=sys.stderr)
+    return statistics.median(times), max(peaks)
+
+
+def scenes(args):
+    if args.scene:
+        return [os.path.abspath(s) for s in args.scene]
+    found = sorted(glob.glob(os.path.join(ROOT, "scenes", "*.pbrt")))
+    shared = os.path.join(ROOT, "..", "shared", "scenes", "pbrt-v3")
+    for name in ["killeroo-simple/killeroo-simple", "cornell-box/cornell_box",
+                 "spheres-motion/spheres-motion", "veach-mis/mis"]:
+        path = os.path.join(shared, f"{name}.pbrt")
+        if os.path.exists(path):
+            found.append(os.path.normpath(path))
+    large = os.path.join(args.large, "large-mesh.pbrt")
+    if not os.path.exists(large):
+        tool = os.path.join(ROOT, "bench", "tools", "make_large_scene.py")
+        subprocess.run([sys.executable, tool, args.large], check=True)
+    found.append(os.path.abspath(large))
+    return found
+
+
+def cell(result, digits=2):
+    return "failed" if result is None else f"{result[0]:.{digits}f}"
+
+
+def table(rows, names, args):
+    head = ["scene"] + [f"{n} s" for n in names]
+    if "pbrt-v4" in names and "acr" in names:
+        head.append("acr speed-up on pbrt-v4")
+    if "pbrt-v3" in names and "acr" in names:
+        head.append("acr speed-up on pbrt-v3")
+    head += [f"{n} peak MiB" for n in names]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for scene, results in rows:
+        line = [scene] + [cell(results.get(n)) for n in names]
+        acr = results.get("acr")
+        for other in ["pbrt-v4", "pbrt-v3"]:
+            if other in names and "acr" in names:
+                theirs = results.get(other)
+                ok = acr is not None and theirs is not None
+                line.append(f"{theirs[0] / acr[0]:.2f}x" if ok else "-")
+        line += ["failed" if results.get(n) is None else f"{results[n][1]:.0f}" for n in names]
+        lines.append("| " + " | ".join(line) + " |")
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip() or "unknown"
+    cpu = platform.processor() or platform.machine()
+    note = (f"Whole process, {args.threads} threads, median of {args.runs} run(s), "
+            f"each scene at its own resolution and spp; acr commit {commit}, {os.cpu_count()} "
+            f"cores ({cpu}), {time.strftime('%Y-%m-%d')}. Written by `bench/versus.py`.")
+    return note + "\n\n" + "\n".join(lines) + "\n"
+
+
+def write(out, text):
+    block = f"{BEGIN}\n{text}{END}"
+    old = open(out).read() if os.path.exists(out) else ""
+    if BEGIN in old and END in old:
+        new = old[: old.index(BEGIN)] + block + old[old.index(END) + len(END):]
+    else:
+        new = old + ("\n" if old and not old.endswith("\n") else "") + block + "\n"
+    with open(out, "w") as f:
+        f.write(new)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--acr", default=os.path.join(ROOT, "target", "release", "acr"))
+    p.add_argument("--pbrt-v3")
+    p.add_argument("--pbrt-v4")
+    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--runs", type=int, default=1)
+    p.add_argument("--scene", action="append")
+    p.add_argument("--large", default=os.path.join(ROOT, "bench", "cache", "large"))
+    p.add_argument("--out")
+    args = p.parse_args()
+    renderers = [("acr", args.acr)]
+    renderers += [(n, b) for n, b in [("pbrt-v3", args.pbrt_v3), ("pbrt-v4", args.pbrt_v4)] if b]
+    for name, binary in renderers:
+        if not os.access(binary, os.X_OK):
+            sys.exit(f"versus.py: {name} binary {binary} is not an executable file")
+    names = [n for n, _ in renderers]
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for scene in scenes(args):
+            name = os.path.splitext(os.path.basename(scene))[0]
+            if os.sep + "shared" + os.sep in scene:
+                name = f"{name} (pbrt-v3's)"
+            print(name, file=sys.stderr)
+            image = os.path.join(tmp, f"{name}.exr")
+            results = {}
+            for label, binary in renderers:
+                if label == "acr":
+                    cmd = [binary, "render", scene, "-o", image, "--threads", str(args.threads),
+                           "--quiet"]
+                    results[label] = measure(label, cmd, args.runs)
+                elif label == "pbrt-v3":
+                    cmd = [binary, "--nthreads", str(args.threads), "--quiet", "--outfile",
+                           image, scene]
+                    results[label] = measure(label, cmd, args.runs)
+                else:
+                    v4 = upgraded(binary, scene)
+                    if v4 is None:
+                        results[label] = None
+                        continue
+                    try:
+                        cmd = [binary, "--nthreads", str(args.threads), "--quiet", "--outfile",
+                               image, v4]
+                        results[label] = measure(label, cmd, args.runs)
+                    finally:
+                        os.remove(v4)
+            rows.append((name, results))
+    text = table(rows, names, args)
+    print(text)
+    if args.out:
+        write(args.out, text)
+
+
+if __name__ == "__main__":
+    main()
