@@ -87,8 +87,10 @@ def scenes(args):
     return found
 
 
-def cell(result, digits=2):
-    return "failed" if result is None else f"{result[0]:.{digits}f}"
+def cell(result):
+    if result is None:
+        return "failed"
+    return f"{result[0]:.2f}" if result[0] >= 1 else f"{result[0]:.3f}"
 
 
 def table(rows, names, args):
