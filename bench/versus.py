@@ -8,7 +8,9 @@ scene as `pbrt --upgrade` rewrites it (written beside the original, so that rela
 PLY paths resolve, and removed afterwards). A renderer whose binary is not given is left out.
 
 usage: python3 bench/versus.py [--acr PATH] [--pbrt-v3 PATH] [--pbrt-v4 PATH] [--threads N]
-           [--runs N] [--scene FILE ...] [--large DIR] [--out FILE.md]
+           [--runs N] [--spp N] [--scene FILE ...] [--large DIR] [--out FILE.md]
+With --spp, every renderer reads a copy of the scene (beside it, removed afterwards) whose
+Sampler's "integer pixelsamples" is N.
 Without --scene: scenes/*.pbrt, the pbrt-v3 scenes in ../shared/scenes/pbrt-v3 when present,
 and a 1M-triangle mesh written by bench/tools/make_large_scene.py into --large (default
 bench/cache/large). With --out, the table replaces the text between the markers
@@ -19,6 +21,7 @@ import argparse
 import glob
 import os
 import platform
+import re
 import statistics
 import subprocess
 import sys
@@ -52,6 +55,19 @@ def upgraded(pbrt_v4, scene):
     path = os.path.join(os.path.dirname(scene), f".versus-v4-{os.path.basename(scene)}")
     with open(path, "w") as f:
         f.write(out.stdout)
+    return path
+
+
+def with_spp(scene, spp):
+    """A copy of the scene beside it with its Sampler's pixelsamples set to spp; None when the
+    scene names none (the renderers' default then applies to all)."""
+    text = open(scene).read()
+    pattern = re.compile(r'("integer pixelsamples"\s*)\[?\s*\d+\s*\]?')
+    if not pattern.search(text):
+        return None
+    path = os.path.join(os.path.dirname(scene), f".versus-spp-{os.path.basename(scene)}")
+    with open(path, "w") as f:
+        f.write(pattern.sub(lambda m: f"{m.group(1)}[{spp}]", text))
     return path
 
 
@@ -114,8 +130,9 @@ def table(rows, names, args):
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip() or "unknown"
     cpu = platform.processor() or platform.machine()
+    spp = f"{args.spp} spp" if args.spp else "its own spp"
     note = (f"Whole process, {args.threads} threads, median of {args.runs} run(s), "
-            f"each scene at its own resolution and spp; acr commit {commit}, {os.cpu_count()} "
+            f"each scene at its own resolution and {spp}; acr commit {commit}, {os.cpu_count()} "
             f"cores ({cpu}), {time.strftime('%Y-%m-%d')}. Written by `bench/versus.py`.")
     return note + "\n\n" + "\n".join(lines) + "\n"
 
@@ -138,6 +155,7 @@ def main():
     p.add_argument("--pbrt-v4")
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--runs", type=int, default=1)
+    p.add_argument("--spp", type=int)
     p.add_argument("--scene", action="append")
     p.add_argument("--large", default=os.path.join(ROOT, "bench", "cache", "large"))
     p.add_argument("--out")
@@ -150,38 +168,46 @@ def main():
     names = [n for n, _ in renderers]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for scene in scenes(args):
-            name = os.path.splitext(os.path.basename(scene))[0]
-            if os.sep + "shared" + os.sep in scene:
-                name = f"{name} (pbrt-v3's)"
-            print(name, file=sys.stderr)
-            image = os.path.join(tmp, f"{name}.exr")
-            results = {}
-            for label, binary in renderers:
-                if label == "acr":
-                    cmd = [binary, "render", scene, "-o", image, "--threads", str(args.threads),
-                           "--quiet"]
-                    results[label] = measure(label, cmd, args.runs)
-                elif label == "pbrt-v3":
-                    cmd = [binary, "--nthreads", str(args.threads), "--quiet", "--outfile",
-                           image, scene]
-                    results[label] = measure(label, cmd, args.runs)
-                else:
-                    v4 = upgraded(binary, scene)
-                    if v4 is None:
-                        results[label] = None
-                        continue
-                    try:
-                        cmd = [binary, "--nthreads", str(args.threads), "--quiet", "--outfile",
-                               image, v4]
-                        results[label] = measure(label, cmd, args.runs)
-                    finally:
-                        os.remove(v4)
-            rows.append((name, results))
+        for original in scenes(args):
+            scene = with_spp(original, args.spp) if args.spp else None
+            try:
+                rows.append(render_all(original, scene or original, renderers, args, tmp))
+            finally:
+                if scene:
+                    os.remove(scene)
     text = table(rows, names, args)
     print(text)
     if args.out:
         write(args.out, text)
+
+
+def render_all(original, scene, renderers, args, tmp):
+    """One table row: each renderer's (seconds, peak MiB) on `scene`, named after `original`."""
+    name = os.path.splitext(os.path.basename(original))[0]
+    if os.sep + "shared" + os.sep in original:
+        name = f"{name} (pbrt-v3's)"
+    print(name, file=sys.stderr)
+    image = os.path.join(tmp, f"{name}.exr")
+    threads = str(args.threads)
+    results = {}
+    for label, binary in renderers:
+        if label == "acr":
+            cmd = [binary, "render", scene, "-o", image, "--threads", threads, "--quiet"]
+            results[label] = measure(label, cmd, args.runs)
+        elif label == "pbrt-v3":
+            cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, scene]
+            results[label] = measure(label, cmd, args.runs)
+        else:
+            v4 = upgraded(binary, scene)
+            if v4 is None:
+                results[label] = None
+                continue
+            try:
+                cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, v4]
+                results[label] = measure(label, cmd, args.runs)
+            finally:
+                os.remove(v4)
+    return name, results
 
 
 if __name__ == "__main__":
