@@ -199,20 +199,36 @@ impl Material {
     /// The BSDF at a hit. With `allow_multiple_lobes` false (pbrt-v3's direct-lighting and
     /// Whitted integrators), a smooth glass gets separate specular reflection and transmission
     /// lobes instead of one `FresnelSpecular`.
+    #[inline]
     pub fn bsdf_with(&self, si: &SurfaceInteraction, allow_multiple_lobes: bool) -> Bsdf {
+        // Built in place: a Bsdf is about 700 bytes, and returning one from each arm copied it
+        // (2-4% of a render in memcpy, perf).
+        let mut b = Bsdf::new(si, 1.0);
+        self.add_lobes(si, allow_multiple_lobes, &mut b, Spectrum::ONE, true);
+        b
+    }
+
+    /// Adds this material's lobes to `b`, each weighted by `scale`; `first` (the material that
+    /// owns the BSDF, as pbrt-v3's mix keeps its first material's) sets the relative index.
+    fn add_lobes(
+        &self,
+        si: &SurfaceInteraction,
+        allow_multiple_lobes: bool,
+        b: &mut Bsdf,
+        scale: Spectrum,
+        first: bool,
+    ) {
         match self {
             Material::Matte { kd, sigma } => {
-                let mut b = Bsdf::new(si, 1.0);
                 let r = clamp0(kd.eval(si));
                 let sig = sigma.eval(si).clamp(0.0, 90.0);
                 if !is_black(r) {
                     if sig == 0.0 {
-                        b.add(Bxdf::Lambertian { r });
+                        b.add_weighted(scale, Bxdf::Lambertian { r });
                     } else {
-                        b.add(Bxdf::oren_nayar(r, sig));
+                        b.add_weighted(scale, Bxdf::oren_nayar(r, sig));
                     }
                 }
-                b
             }
             Material::Plastic {
                 kd,
@@ -220,36 +236,38 @@ impl Material {
                 roughness,
                 remap_roughness,
             } => {
-                let mut b = Bsdf::new(si, 1.0);
                 let kd = clamp0(kd.eval(si));
                 if !is_black(kd) {
-                    b.add(Bxdf::Lambertian { r: kd });
+                    b.add_weighted(scale, Bxdf::Lambertian { r: kd });
                 }
                 let ks = clamp0(ks.eval(si));
                 if !is_black(ks) {
                     let rough = roughness.eval(si);
-                    b.add(Bxdf::MicrofacetReflection {
-                        r: ks,
-                        distribution: distribution(rough, rough, *remap_roughness),
-                        // pbrt-v3 builds this Fresnel with the indices swapped.
-                        fresnel: Fresnel::Dielectric {
-                            eta_i: 1.5,
-                            eta_t: 1.0,
+                    b.add_weighted(
+                        scale,
+                        Bxdf::MicrofacetReflection {
+                            r: ks,
+                            distribution: distribution(rough, rough, *remap_roughness),
+                            // pbrt-v3 builds this Fresnel with the indices swapped.
+                            fresnel: Fresnel::Dielectric {
+                                eta_i: 1.5,
+                                eta_t: 1.0,
+                            },
                         },
-                    });
+                    );
                 }
-                b
             }
             Material::Mirror { kr } => {
-                let mut b = Bsdf::new(si, 1.0);
                 let r = clamp0(kr.eval(si));
                 if !is_black(r) {
-                    b.add(Bxdf::SpecularReflection {
-                        r,
-                        fresnel: Fresnel::NoOp,
-                    });
+                    b.add_weighted(
+                        scale,
+                        Bxdf::SpecularReflection {
+                            r,
+                            fresnel: Fresnel::NoOp,
+                        },
+                    );
                 }
-                b
             }
             Material::Glass {
                 kr,
@@ -263,19 +281,24 @@ impl Material {
                 let (urough, vrough) = (u_roughness.eval(si), v_roughness.eval(si));
                 let r = clamp0(kr.eval(si));
                 let t = clamp0(kt.eval(si));
-                let mut b = Bsdf::new(si, eta);
+                if first {
+                    b.set_eta(eta);
+                }
                 if is_black(r) && is_black(t) {
-                    return b;
+                    return;
                 }
                 let specular = urough == 0.0 && vrough == 0.0;
                 if specular && allow_multiple_lobes {
-                    b.add(Bxdf::FresnelSpecular {
-                        r,
-                        t,
-                        eta_a: 1.0,
-                        eta_b: eta,
-                    });
-                    return b;
+                    b.add_weighted(
+                        scale,
+                        Bxdf::FresnelSpecular {
+                            r,
+                            t,
+                            eta_a: 1.0,
+                            eta_b: eta,
+                        },
+                    );
+                    return;
                 }
                 let dist = distribution(urough, vrough, *remap_roughness);
                 if !is_black(r) {
@@ -283,33 +306,38 @@ impl Material {
                         eta_i: 1.0,
                         eta_t: eta,
                     };
-                    b.add(if specular {
-                        Bxdf::SpecularReflection { r, fresnel }
-                    } else {
-                        Bxdf::MicrofacetReflection {
-                            r,
-                            distribution: dist,
-                            fresnel,
-                        }
-                    });
+                    b.add_weighted(
+                        scale,
+                        if specular {
+                            Bxdf::SpecularReflection { r, fresnel }
+                        } else {
+                            Bxdf::MicrofacetReflection {
+                                r,
+                                distribution: dist,
+                                fresnel,
+                            }
+                        },
+                    );
                 }
                 if !is_black(t) {
-                    b.add(if specular {
-                        Bxdf::SpecularTransmission {
-                            t,
-                            eta_a: 1.0,
-                            eta_b: eta,
-                        }
-                    } else {
-                        Bxdf::MicrofacetTransmission {
-                            t,
-                            distribution: dist,
-                            eta_a: 1.0,
-                            eta_b: eta,
-                        }
-                    });
+                    b.add_weighted(
+                        scale,
+                        if specular {
+                            Bxdf::SpecularTransmission {
+                                t,
+                                eta_a: 1.0,
+                                eta_b: eta,
+                            }
+                        } else {
+                            Bxdf::MicrofacetTransmission {
+                                t,
+                                distribution: dist,
+                                eta_a: 1.0,
+                                eta_b: eta,
+                            }
+                        },
+                    );
                 }
-                b
             }
             Material::Metal {
                 eta,
@@ -319,23 +347,24 @@ impl Material {
                 v_roughness,
                 remap_roughness,
             } => {
-                let mut b = Bsdf::new(si, 1.0);
                 let u = u_roughness
                     .as_ref()
                     .map_or_else(|| roughness.eval(si), |t| t.eval(si));
                 let v = v_roughness
                     .as_ref()
                     .map_or_else(|| roughness.eval(si), |t| t.eval(si));
-                b.add(Bxdf::MicrofacetReflection {
-                    r: Spectrum::ONE,
-                    distribution: distribution(u, v, *remap_roughness),
-                    fresnel: Fresnel::Conductor {
-                        eta_i: Spectrum::ONE,
-                        eta_t: eta.eval(si),
-                        k: k.eval(si),
+                b.add_weighted(
+                    scale,
+                    Bxdf::MicrofacetReflection {
+                        r: Spectrum::ONE,
+                        distribution: distribution(u, v, *remap_roughness),
+                        fresnel: Fresnel::Conductor {
+                            eta_i: Spectrum::ONE,
+                            eta_t: eta.eval(si),
+                            k: k.eval(si),
+                        },
                     },
-                });
-                b
+                );
             }
             Material::Uber {
                 kd,
@@ -352,20 +381,21 @@ impl Material {
                 let e = eta.eval(si);
                 let op = clamp0(opacity.eval(si));
                 let t = clamp0(Spectrum::ONE - op);
-                let mut b = if !is_black(t) {
-                    let mut b = Bsdf::new(si, 1.0);
-                    b.add(Bxdf::SpecularTransmission {
-                        t,
-                        eta_a: 1.0,
-                        eta_b: 1.0,
-                    });
-                    b
-                } else {
-                    Bsdf::new(si, e)
-                };
+                if !is_black(t) {
+                    b.add_weighted(
+                        scale,
+                        Bxdf::SpecularTransmission {
+                            t,
+                            eta_a: 1.0,
+                            eta_b: 1.0,
+                        },
+                    );
+                } else if first {
+                    b.set_eta(e);
+                }
                 let kd = op * clamp0(kd.eval(si));
                 if !is_black(kd) {
-                    b.add(Bxdf::Lambertian { r: kd });
+                    b.add_weighted(scale, Bxdf::Lambertian { r: kd });
                 }
                 let ks = op * clamp0(ks.eval(si));
                 if !is_black(ks) {
@@ -373,34 +403,42 @@ impl Material {
                         .as_ref()
                         .map_or_else(|| roughness.eval(si), |t| t.eval(si));
                     let v = v_roughness.as_ref().map_or(u, |t| t.eval(si));
-                    b.add(Bxdf::MicrofacetReflection {
-                        r: ks,
-                        distribution: distribution(u, v, *remap_roughness),
-                        fresnel: Fresnel::Dielectric {
-                            eta_i: 1.0,
-                            eta_t: e,
+                    b.add_weighted(
+                        scale,
+                        Bxdf::MicrofacetReflection {
+                            r: ks,
+                            distribution: distribution(u, v, *remap_roughness),
+                            fresnel: Fresnel::Dielectric {
+                                eta_i: 1.0,
+                                eta_t: e,
+                            },
                         },
-                    });
+                    );
                 }
                 let kr = op * clamp0(kr.eval(si));
                 if !is_black(kr) {
-                    b.add(Bxdf::SpecularReflection {
-                        r: kr,
-                        fresnel: Fresnel::Dielectric {
-                            eta_i: 1.0,
-                            eta_t: e,
+                    b.add_weighted(
+                        scale,
+                        Bxdf::SpecularReflection {
+                            r: kr,
+                            fresnel: Fresnel::Dielectric {
+                                eta_i: 1.0,
+                                eta_t: e,
+                            },
                         },
-                    });
+                    );
                 }
                 let kt = op * clamp0(kt.eval(si));
                 if !is_black(kt) {
-                    b.add(Bxdf::SpecularTransmission {
-                        t: kt,
-                        eta_a: 1.0,
-                        eta_b: e,
-                    });
+                    b.add_weighted(
+                        scale,
+                        Bxdf::SpecularTransmission {
+                            t: kt,
+                            eta_a: 1.0,
+                            eta_b: e,
+                        },
+                    );
                 }
-                b
             }
             Material::Substrate {
                 kd,
@@ -409,32 +447,28 @@ impl Material {
                 v_roughness,
                 remap_roughness,
             } => {
-                let mut b = Bsdf::new(si, 1.0);
                 let d = clamp0(kd.eval(si));
                 let s = clamp0(ks.eval(si));
                 if !is_black(d) || !is_black(s) {
                     let (u, v) = (u_roughness.eval(si), v_roughness.eval(si));
-                    b.add(Bxdf::FresnelBlend {
-                        rd: d,
-                        rs: s,
-                        distribution: distribution(u, v, *remap_roughness),
-                    });
+                    b.add_weighted(
+                        scale,
+                        Bxdf::FresnelBlend {
+                            rd: d,
+                            rs: s,
+                            distribution: distribution(u, v, *remap_roughness),
+                        },
+                    );
                 }
-                b
             }
             Material::Mix { amount, materials } => {
                 let s1 = clamp0(amount.eval(si));
                 let s2 = clamp0(Spectrum::ONE - s1);
-                let mut b = materials[0].bsdf_with(si, allow_multiple_lobes);
-                b.scale_lobes(s1);
-                let b2 = materials[1].bsdf_with(si, allow_multiple_lobes);
-                for l in b2.lobes() {
-                    // pbrt-v3 asserts when more than 8 lobes result; acr drops the extras.
-                    b.add_scaled(l.bxdf, l.scale * s2);
-                }
-                b
+                // pbrt-v3 asserts when more than 8 lobes result; acr drops the extras.
+                materials[0].add_lobes(si, allow_multiple_lobes, b, s1 * scale, first);
+                materials[1].add_lobes(si, allow_multiple_lobes, b, s2 * scale, false);
             }
-            Material::Interface => Bsdf::new(si, 1.0),
+            Material::Interface => {}
         }
     }
 }
