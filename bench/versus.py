@@ -53,8 +53,11 @@ def upgraded(pbrt_v4, scene):
         print(f"  pbrt-v4 --upgrade failed: {out.stderr.strip()[-300:]}", file=sys.stderr)
         return None
     path = os.path.join(os.path.dirname(scene), f".versus-v4-{os.path.basename(scene)}")
+    # pbrt-v4's upgrader keeps pbrt-v3's parameter name, which pbrt-v4's path integrator
+    # rejects as unused ("lightsampler" there; its parser.cpp, upgrade of "path").
+    text = out.stdout.replace('"string lightsamplestrategy"', '"string lightsampler"')
     with open(path, "w") as f:
-        f.write(out.stdout)
+        f.write(text)
     return path
 
 

@@ -3,15 +3,21 @@
 //! An `.exr` (or `.pfm`) holds the values themselves; a `.png` a false-colour picture scaled
 //! by the largest value, which is written into the PNG (a tEXt chunk) and printed. `clusters`
 //! is the cluster sampler's final partition: in a PNG each cluster a colour with its borders
-//! drawn dark (the paper's figures 2 and 4), in an EXR each pixel's cluster id.
+//! drawn dark (the paper's figures 2 and 4), in an EXR each pixel's cluster id. `albedo`,
+//! `normal` and `depth` are the means of each pixel's first-hit features (`features.rs`), linear
+//! in an EXR or PFM, as Open Image Denoise's tools read them.
 
+use crate::features::FeatureImage;
 use crate::geometry::Spectrum;
 use crate::image_io::{write_image, RgbImage};
 use acr_plugins::{Partition, PixelStats};
 use std::path::{Path, PathBuf};
 
 /// The AOVs acr writes.
-pub const AOV_NAMES: &[&str] = &["spp", "variance", "clusters"];
+pub const AOV_NAMES: &[&str] = &["spp", "variance", "clusters", "albedo", "normal", "depth"];
+
+/// The AOVs made of first-hit features (the render collects them only when one is asked for).
+pub const FEATURE_AOVS: &[&str] = &["albedo", "normal", "depth"];
 
 /// One requested AOV.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -23,6 +29,11 @@ pub struct AovRequest {
 }
 
 impl AovRequest {
+    /// Whether this AOV is made of first-hit features.
+    pub fn is_feature(&self) -> bool {
+        FEATURE_AOVS.contains(&self.name.as_str())
+    }
+
     /// The file's extension, lower case ("" when none): it picks the format.
     fn extension(&self) -> String {
         self.path
@@ -52,10 +63,17 @@ pub fn parse_aovs(arg: &str) -> Result<Vec<AovRequest>, String> {
             if file.is_empty() {
                 return Err(format!("--aov {name}: the file name is empty"));
             }
-            Ok(AovRequest {
+            let req = AovRequest {
                 name: name.to_owned(),
                 path: PathBuf::from(file),
-            })
+            };
+            if req.is_feature() && !matches!(req.extension().as_str(), "exr" | "pfm") {
+                return Err(format!(
+                    "--aov {name}: \"{file}\" must be an .exr or .pfm (linear values, as \
+                     denoisers read them)"
+                ));
+            }
+            Ok(req)
         })
         .collect()
 }
@@ -79,12 +97,19 @@ pub fn write_aov(
     height: usize,
     stats: &[PixelStats],
     partition: Option<&Partition>,
+    features: Option<&FeatureImage>,
 ) -> Result<String, String> {
     if req.name == "clusters" {
         let p = partition.ok_or("--aov clusters: the sampler made no clusters")?;
         return write_clusters(req, p);
     }
-    let values = aov_values(&req.name, stats);
+    let values = if req.is_feature() {
+        let f =
+            features.ok_or_else(|| format!("--aov {}: no features were collected", req.name))?;
+        f.image(&req.name)
+    } else {
+        aov_values(&req.name, stats)
+    };
     let ext = req.extension();
     if ext != "png" {
         write_image(

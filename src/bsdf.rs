@@ -750,6 +750,29 @@ impl Bsdf {
         self.ng
     }
 
+    /// The albedo for first-hit features: each lobe's nominal reflectance or transmittance
+    /// (its `r`, `t`, or `rd + rs`) times its weight, summed and kept in [0, 1].
+    pub fn albedo(&self) -> Spectrum {
+        let sum: Spectrum = self
+            .lobes()
+            .iter()
+            .map(|l| {
+                let nominal = match l.bxdf {
+                    Bxdf::Lambertian { r }
+                    | Bxdf::OrenNayar { r, .. }
+                    | Bxdf::SpecularReflection { r, .. }
+                    | Bxdf::MicrofacetReflection { r, .. } => r,
+                    Bxdf::SpecularTransmission { t, .. }
+                    | Bxdf::MicrofacetTransmission { t, .. } => t,
+                    Bxdf::FresnelSpecular { r, t, .. } => r.max(t),
+                    Bxdf::FresnelBlend { rd, rs, .. } => rd + rs,
+                };
+                nominal * l.scale
+            })
+            .sum();
+        sum.clamp(Spectrum::ZERO, Spectrum::ONE)
+    }
+
     /// Whether any lobe is not a delta distribution (so light sampling can help).
     pub fn has_non_specular(&self) -> bool {
         self.lobes().iter().any(|l| !l.bxdf.is_specular())

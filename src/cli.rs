@@ -1,10 +1,11 @@
 //! The `acr` command line: subcommands and their arguments.
 
 use crate::aov::{parse_aovs, write_aov, AovRequest};
+use crate::features::FeatureImage;
 use crate::image_io::{write_image, RgbImage};
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
-use crate::render::{render, MAX_SPP};
+use crate::render::{render, render_with_features, MAX_SPP};
 use crate::replay::{Recording, Replay};
 use crate::scene::Scene;
 use crate::stats::{median, peak_rss_mb, Seconds, Stats};
@@ -88,8 +89,9 @@ pub struct RenderArgs {
     #[arg(long = "set", value_name = "KIND.PARAM=VALUE")]
     pub set: Vec<String>,
     /// Extra per-pixel outputs, NAME=FILE[,NAME=FILE]: spp (samples per pixel), variance (of
-    /// each pixel's mean). An .exr holds the values; a .png is false colour scaled by the
-    /// largest value (the scale is printed and stored in the PNG). Repeatable.
+    /// each pixel's mean), clusters (cluster sampler), albedo, normal, depth (means of the
+    /// first-hit features, .exr or .pfm). An .exr holds the values; a .png is false colour
+    /// scaled by the largest value (the scale is printed and stored in the PNG). Repeatable.
     #[arg(long, value_name = "NAME=FILE")]
     pub aov: Vec<String>,
     /// Worker threads (default: every core).
@@ -335,15 +337,39 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     } else {
         recording.inner()
     };
-    let counts = render(
-        &scene,
-        &plugins.integrator,
-        sampler,
-        &mut film,
-        args.seed,
-        args.time_limit.map(std::time::Duration::from_secs_f64),
-        bar.as_ref(),
-    );
+    let time_limit = args.time_limit.map(std::time::Duration::from_secs_f64);
+    let mut features = aovs.iter().any(AovRequest::is_feature).then(|| {
+        let [x0, x1, y0, y1] = scene.film.crop;
+        FeatureImage::new(x0, x1, y0, y1)
+    });
+    let counts = match features.as_mut() {
+        Some(f) => render_with_features(
+            &scene,
+            &plugins.integrator,
+            sampler,
+            &mut film,
+            args.seed,
+            time_limit,
+            bar.as_ref(),
+            f,
+        ),
+        None => render(
+            &scene,
+            &plugins.integrator,
+            sampler,
+            &mut film,
+            args.seed,
+            time_limit,
+            bar.as_ref(),
+        ),
+    };
+    if let Some(f) = features.as_ref().filter(|f| f.non_finite > 0) {
+        eprintln!(
+            "warning: {} samples had non-finite first-hit features; they are left out of the \
+             feature AOVs",
+            f.non_finite
+        );
+    }
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -378,6 +404,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             h as usize,
             film.pixel_stats(),
             plugins.sampler.partition(),
+            features.as_ref(),
         )?;
         if !args.quiet {
             eprintln!("{line}");

@@ -6,6 +6,7 @@
 //! for emission it hits (as pbrt-v4 does), where pbrt-v3 traces a separate ray for it. Same
 //! expectation, one ray fewer per bounce.
 
+use crate::features::{FirstHit, FirstHitProbe};
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
@@ -56,6 +57,8 @@ pub struct Radiance {
     pub l: Spectrum,
     /// Rays traced for it (camera, continuation and shadow rays).
     pub rays: u32,
+    /// What the camera path saw first (`--aov albedo/normal/depth`).
+    pub first_hit: FirstHit,
 }
 
 /// Builds an integrator from its checked parameters.
@@ -185,9 +188,13 @@ impl Integrator {
                 max_depth,
                 strategy,
             } => {
-                let mut rays = 0;
-                let l = direct_li(scene, ray, stream, max_depth, 0, strategy, &mut rays);
-                Radiance { l, rays }
+                let mut tally = Tally::default();
+                let l = direct_li(scene, ray, stream, max_depth, 0, strategy, &mut tally);
+                Radiance {
+                    l,
+                    rays: tally.rays,
+                    first_hit: tally.probe.features(),
+                }
             }
         }
     }
@@ -252,6 +259,7 @@ fn path_li(
     let mut prev_ctx: Option<LightContext> = None;
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
+    let mut probe = FirstHitProbe::default();
     loop {
         rays += 1;
         let Some(hit) = scene.intersect(&ray) else {
@@ -271,6 +279,7 @@ fn path_li(
             break;
         };
         let si = hit.si;
+        probe.travel(ray.o, si.p);
         if let Some(li) = hit.surface.area_light {
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
@@ -300,6 +309,7 @@ fn path_li(
             break;
         }
         let bsdf = scene.materials[material as usize].bsdf(&si);
+        probe.surface(&si, &bsdf);
         prev_ctx = None;
         if have_lights && bsdf.has_non_specular() {
             let ctx = LightContext {
@@ -363,7 +373,18 @@ fn path_li(
             beta /= 1.0 - q;
         }
     }
-    Radiance { l, rays }
+    Radiance {
+        l,
+        rays,
+        first_hit: probe.features(),
+    }
+}
+
+/// What a recursive estimate counts on its way: rays traced and the first-hit features.
+#[derive(Default)]
+struct Tally {
+    rays: u32,
+    probe: FirstHitProbe,
 }
 
 /// pbrt-v3's DirectLightingIntegrator: emission, direct light at the first non-specular hit
@@ -377,13 +398,17 @@ fn direct_li(
     max_depth: u32,
     depth: u32,
     strategy: DirectStrategy,
-    rays: &mut u32,
+    tally: &mut Tally,
 ) -> Spectrum {
     let mut ray = ray;
     let mut pass_through = 0;
     let hit = loop {
-        *rays += 1;
-        match scene.intersect(&ray) {
+        tally.rays += 1;
+        let hit = scene.intersect(&ray);
+        if let Some(h) = &hit {
+            tally.probe.travel(ray.o, h.si.p);
+        }
+        match hit {
             None => {
                 return scene
                     .infinite_lights
@@ -407,11 +432,12 @@ fn direct_li(
         return l;
     };
     let bsdf = scene.materials[material as usize].bsdf(&si);
+    tally.probe.surface(&si, &bsdf);
     if bsdf.has_non_specular() && !scene.lights.is_empty() {
         match strategy {
             DirectStrategy::All => {
                 for i in 0..scene.lights.len() as u32 {
-                    l += estimate_direct(scene, &si, &bsdf, i, 1.0, stream, rays);
+                    l += estimate_direct(scene, &si, &bsdf, i, 1.0, stream, &mut tally.rays);
                 }
             }
             DirectStrategy::One => {
@@ -422,7 +448,7 @@ fn direct_li(
                 if let Some((i, pdf)) =
                     scene.choose_light(LightStrategy::Uniform, ctx, stream.next_1d())
                 {
-                    l += estimate_direct(scene, &si, &bsdf, i as u32, pdf, stream, rays);
+                    l += estimate_direct(scene, &si, &bsdf, i as u32, pdf, stream, &mut tally.rays);
                 }
             }
         }
@@ -436,7 +462,7 @@ fn direct_li(
                 if weight != Spectrum::ZERO && crate::geometry::is_valid_radiance(weight) {
                     let next = si.spawn_ray(s.wi);
                     l += weight
-                        * direct_li(scene, next, stream, max_depth, depth + 1, strategy, rays);
+                        * direct_li(scene, next, stream, max_depth, depth + 1, strategy, tally);
                 }
             }
         }

@@ -7,6 +7,7 @@ pub mod bench;
 pub mod bsdf;
 pub mod camera;
 pub mod cli;
+pub mod features;
 pub use acr_plugins::film;
 pub mod geometry;
 pub mod image_io;

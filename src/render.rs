@@ -2,6 +2,7 @@
 //! added to the film in a fixed order, so the image depends on the scene, seed and budget only.
 
 use crate::camera::CameraSample;
+use crate::features::{FeatureImage, FirstHit};
 use crate::geometry::Ray;
 use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
 use crate::integrator::{Integrator, Radiance};
@@ -63,7 +64,32 @@ pub fn render(
     progress: Option<&indicatif::ProgressBar>,
 ) -> RenderCounts {
     let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
-    render_with(scene, &li, sampler, film, seed, time_limit, progress)
+    render_with(scene, &li, sampler, film, seed, time_limit, progress, None)
+}
+
+/// [`render`], also adding each sample's first-hit features to `features`.
+#[allow(clippy::too_many_arguments)]
+pub fn render_with_features(
+    scene: &Scene,
+    integrator: &Integrator,
+    sampler: &mut dyn Sampler,
+    film: &mut Film,
+    seed: u64,
+    time_limit: Option<Duration>,
+    progress: Option<&indicatif::ProgressBar>,
+    features: &mut FeatureImage,
+) -> RenderCounts {
+    let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
+    render_with(
+        scene,
+        &li,
+        sampler,
+        film,
+        seed,
+        time_limit,
+        progress,
+        Some(features),
+    )
 }
 
 /// A traced batch and what became of its samples, waiting for the sampler and the film.
@@ -79,11 +105,20 @@ struct Traced {
 impl Traced {
     /// Takes `results` of `self.batch`: counts them, drops radiance that is NaN, infinite or
     /// negative, and clamps the rest by the film's limits.
-    fn take(&mut self, results: &[(Spectrum, u32)], film: &Film, counts: &mut RenderCounts) {
+    fn take(
+        &mut self,
+        results: &[Traced1],
+        film: &Film,
+        counts: &mut RenderCounts,
+        mut features: Option<&mut FeatureImage>,
+    ) {
         self.valid.clear();
         self.radiance.clear();
-        for (q, &(l, rays)) in self.batch.iter().zip(results) {
+        for (q, &(l, rays, first_hit)) in self.batch.iter().zip(results) {
             counts.rays += u64::from(rays);
+            if let Some(f) = features.as_deref_mut() {
+                f.add(Vec2::from(q.film), &first_hit);
+            }
             if is_valid_radiance(l) {
                 let l = film.settings().clamp(l);
                 self.valid.push((Vec2::from(q.film), l));
@@ -116,9 +151,14 @@ fn timed<T>(total: &mut Duration, f: impl FnOnce() -> T) -> T {
 /// What a sample estimates: the radiance arriving along a camera ray.
 pub type Estimator<'a> = dyn Fn(&Scene, Ray, &mut SampleStream) -> Radiance + Sync + 'a;
 
+/// One traced sample: its radiance, rays and first-hit features.
+type Traced1 = (Spectrum, u32, FirstHit);
+
 /// [`render`] with any estimator in place of an integrator (tests give it one that misbehaves).
 /// Radiance that is NaN, infinite or negative is dropped and counted where it arises; the rest
-/// is clamped by the film's limits before the sampler, the cells and the film see it.
+/// is clamped by the film's limits before the sampler, the cells and the film see it. With
+/// `features`, each sample's first-hit features are added there.
+#[allow(clippy::too_many_arguments)]
 pub fn render_with(
     scene: &Scene,
     li: &Estimator<'_>,
@@ -127,6 +167,7 @@ pub fn render_with(
     seed: u64,
     time_limit: Option<Duration>,
     progress: Option<&indicatif::ProgressBar>,
+    mut features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
     let start = Instant::now();
     let full_width = u64::from(scene.film.resolution.0);
@@ -135,7 +176,7 @@ pub fn render_with(
     if let Some(p) = progress {
         p.set_length(space.pixels() * u64::from(sampler.spp()));
     }
-    let trace = |batch: &[SamplePoint], results: &mut Vec<(Spectrum, u32)>| {
+    let trace = |batch: &[SamplePoint], results: &mut Vec<Traced1>| {
         batch
             .par_iter()
             .map(|q| {
@@ -148,13 +189,13 @@ pub fn render_with(
                     time: q.time,
                 });
                 let r = li(scene, ray, &mut stream);
-                (r.l, r.rays)
+                (r.l, r.rays, r.first_hit)
             })
             .collect_into_vec(results);
     };
     // Reused from batch to batch: a fresh half-megabyte vector per batch costs page faults.
     let (mut batch, mut next) = (Vec::new(), Vec::new());
-    let mut results: Vec<(Spectrum, u32)> = Vec::new();
+    let mut results: Vec<Traced1> = Vec::new();
     // The last batch traced, when the sampler and the film have not yet seen it.
     let mut traced = Traced::default();
     let mut pending = false;
@@ -174,7 +215,7 @@ pub fn render_with(
             },
         );
         std::mem::swap(&mut traced.batch, &mut batch);
-        traced.take(&results, film, &mut counts);
+        traced.take(&results, film, &mut counts, features.as_deref_mut());
         pending = true;
         if let Some(p) = progress {
             p.set_position(counts.samples);

@@ -212,6 +212,7 @@ fn an_estimator_returning_nan_for_half_its_samples_leaves_a_finite_image_and_cou
         7,
         None,
         None,
+        None,
     );
     let image = plugins.image(&film);
     let (w, h) = scene.film.size();
