@@ -46,9 +46,26 @@ def run(cmd, cwd=None):
     return seconds, usage.ru_maxrss / 1024.0, proc.returncode, " / ".join(tail)
 
 
+def inlined(path, base, depth=0):
+    """The text of the scene at `path` with every Include replaced by the included text
+    (relative to `base`, the main file's folder, as pbrt-v3 resolves them)."""
+    if depth > 16:
+        sys.exit(f"versus.py: {path}: Include nested too deeply")
+    include = re.compile(r'^\s*Include\s+"([^"]+)"\s*$', re.MULTILINE)
+    text = open(path).read()
+    return include.sub(lambda m: inlined(os.path.join(base, m.group(1)), base, depth + 1), text)
+
+
 def upgraded(pbrt_v4, scene):
-    """The scene rewritten by `pbrt --upgrade`, beside the original; None when that fails."""
-    out = subprocess.run([pbrt_v4, "--upgrade", scene], capture_output=True, text=True)
+    """The scene rewritten by `pbrt --upgrade`, beside the original; None when that fails.
+    Included files are inlined first: the upgrader rewrites only the file it is given."""
+    flat = os.path.join(os.path.dirname(scene), f".versus-flat-{os.path.basename(scene)}")
+    with open(flat, "w") as f:
+        f.write(inlined(scene, os.path.dirname(scene)))
+    try:
+        out = subprocess.run([pbrt_v4, "--upgrade", flat], capture_output=True, text=True)
+    finally:
+        os.remove(flat)
     if out.returncode != 0:
         print(f"  pbrt-v4 --upgrade failed: {out.stderr.strip()[-300:]}", file=sys.stderr)
         return None

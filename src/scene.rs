@@ -430,7 +430,7 @@ impl Builder<'_> {
                 let from = vec3_param(params, "from", Vec3::ZERO)?;
                 let to = vec3_param(params, "to", Vec3::Z)?;
                 let cone = params.float_or("coneangle", 30.0)? as f32;
-                let delta = params.float_or("conedelta", 5.0)? as f32;
+                let delta = params.float_or("conedeltaangle", 5.0)? as f32;
                 let pos = m.transform_point3(from);
                 let dir = m.transform_vector3(to - from).normalize_or_zero();
                 if dir == Vec3::ZERO {
@@ -744,5 +744,37 @@ impl Scene {
             world_radius,
             render_from_world,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// pbrt-v3's spot light reads its falloff from "conedeltaangle" (default 5 degrees).
+    #[test]
+    fn a_spot_light_falls_off_over_conedeltaangle() {
+        for (param, delta) in [("\"float conedeltaangle\" 12", 12.0f32), ("", 5.0)] {
+            let text = format!(
+                "Camera \"perspective\"\nWorldBegin\nLightSource \"spot\" \
+                 \"float coneangle\" 40 {param}\nShape \"sphere\"\nWorldEnd"
+            );
+            let desc = acr_parser::parse_str(&text, Path::new("spot.pbrt")).unwrap();
+            let mut warnings = Vec::new();
+            let scene = Scene::build(&desc, &mut warnings).unwrap();
+            let Some(Light::Spot {
+                cos_total,
+                cos_falloff_start,
+                ..
+            }) = scene.lights.first()
+            else {
+                panic!("no spot light");
+            };
+            assert!((cos_total - 40f32.to_radians().cos()).abs() < 1e-6);
+            let expected = (40.0 - delta).to_radians().cos();
+            assert!((cos_falloff_start - expected).abs() < 1e-6, "{param}");
+            assert!(desc.unused_parameter_warnings().is_empty(), "{param}");
+        }
     }
 }
