@@ -16,6 +16,8 @@ use glam::{Mat4, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::BvhBuildParams;
+use rayon::prelude::*;
+use std::ops::Range;
 use std::time::Duration;
 
 mod parts;
@@ -169,23 +171,28 @@ impl Geometry {
             },
             max_part,
         );
-        // Part by part, so that the builder's transient memory is one part's.
-        let mut ordered = Vec::with_capacity(prims.len());
-        let mut parts = Vec::with_capacity(ranges.len());
-        for range in ranges {
-            let part = &prims[range];
-            let aabbs: Vec<Aabb> = part
+        // As many parts at a time as there are threads: obvhs converts its binary BVH into
+        // the wide one on one thread, and the builder's transient memory is that many parts'.
+        let build_part = |range: &Range<usize>| {
+            let aabbs: Vec<Aabb> = prims[range.clone()]
                 .iter()
                 .map(|p| {
                     let (lo, hi) = self.prim_bounds(p);
                     Aabb::new(Vec3A::from(lo), Vec3A::from(hi))
                 })
                 .collect();
-            let bvh = obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut Duration::default());
-            drop(aabbs);
-            let base = ordered.len() as u32;
-            ordered.extend(bvh.primitive_indices.iter().map(|&i| part[i as usize]));
-            parts.push((bvh, base));
+            obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut Duration::default())
+        };
+        let mut ordered = Vec::with_capacity(prims.len());
+        let mut parts = Vec::with_capacity(ranges.len());
+        for group in ranges.chunks(rayon::current_num_threads().max(1)) {
+            let built: Vec<CwBvh> = group.par_iter().map(build_part).collect();
+            for (range, bvh) in group.iter().zip(built) {
+                let part = &prims[range.clone()];
+                let base = ordered.len() as u32;
+                ordered.extend(bvh.primitive_indices.iter().map(|&i| part[i as usize]));
+                parts.push((bvh, base));
+            }
         }
         drop(prims);
         self.prims = ordered;

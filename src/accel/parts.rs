@@ -4,7 +4,7 @@
 //! obvhs's builder holds, while it converts its binary BVH into the wide one, about 180 bytes
 //! per primitive beside the result (the binary nodes and the conversion's cost table): 300 MB
 //! at the peak of a million-triangle build, more than the scene itself. Built part by part,
-//! that transient memory is one part's. The parts are halves of halves along the widest axis
+//! that transient memory is a few parts'. The parts are halves of halves along the widest axis
 //! of their centroids (at most eight), and a new root whose children are the parts' roots
 //! joins their BVHs into one, so traversal is unchanged: one stack, one tree.
 
@@ -20,8 +20,9 @@ use std::ops::Range;
 pub const MAX_PARTS: usize = 8;
 
 /// Most primitives in one part: beyond this, a geometry is split (measured on a 1M-triangle
-/// mesh: build peak 362 MB whole, see docs/BENCHMARKS.md for the figures per part size).
-pub const PART_PRIMS: usize = 1 << 18;
+/// mesh, docs/BENCHMARKS.md: with two parts built at a time, 2^17 keeps the peak at 155 MB
+/// where 2^18 reached 212 MB, at about the same build time).
+pub const PART_PRIMS: usize = 1 << 17;
 
 /// Reorders `prims` (with their centroids) so that each part is a contiguous range, and
 /// returns the ranges: one when `prims` holds at most `max` primitives.
