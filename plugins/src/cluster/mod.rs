@@ -3,6 +3,7 @@
 //! drives it; a reconstruction that needs clusters builds them with the same code.
 
 pub mod build;
+pub mod by_noise;
 pub mod clusters;
 pub mod features;
 pub mod grid;

@@ -8,6 +8,7 @@
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
 use crate::cluster::build::{initial_clustering, Initial};
+use crate::cluster::by_noise::{grow_by_noise, NoiseClusters};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
@@ -35,6 +36,8 @@ pub struct PolynomialFilter {
     /// The fit's own clustering (ω, most cells), grown from the cells even where the sampler
     /// gives one; None: the sampler's clusters, or the sampler's defaults.
     own: Option<(f64, u32)>,
+    /// With z > 0: the fit's clusters merged by noise at z standard errors (`by_noise.rs`).
+    noise_z: f64,
 }
 
 impl PolynomialFilter {
@@ -48,7 +51,14 @@ impl PolynomialFilter {
             kernel: BoxFilter::new(0.5, 0.5),
             fitted: Mutex::new([0; MAX_DEGREE as usize + 1]),
             own: None,
+            noise_z: 0.0,
         }
+    }
+
+    /// Fits clusters merged by noise at `z` standard errors (0: off).
+    pub fn with_noise_clusters(mut self, z: f64) -> Self {
+        self.noise_z = z;
+        self
     }
 
     /// Fits clusters grown here with `omega` and at most `max_cells` cells, whatever the
@@ -67,8 +77,19 @@ impl PolynomialFilter {
     fn reconstruct_cells(&self, film: &Film, view: CellView<'_>) -> Vec<Spectrum> {
         let (grid, sums) = (view.grid, view.sums);
         let grown: Option<Initial>;
-        let clustering = match (view.clustering, self.own) {
-            (Some(c), None) => c,
+        let by_noise: NoiseClusters;
+        let (cluster_cells, of_cell): (Vec<&[u32]>, &[u32]) = match (view.clustering, self.own) {
+            _ if self.noise_z > 0.0 => {
+                by_noise = grow_by_noise(grid, sums, self.noise_z);
+                (
+                    by_noise.clusters.iter().map(Vec::as_slice).collect(),
+                    &by_noise.of_cell,
+                )
+            }
+            (Some(c), None) => (
+                c.clusters.iter().map(|c| c.cells.as_slice()).collect(),
+                &c.of_cell,
+            ),
             (_, own) => {
                 let mut params = ClusterSettings::new(1).cluster_params();
                 if let Some((omega, max_cells)) = own {
@@ -76,7 +97,11 @@ impl PolynomialFilter {
                     params.max_cluster_cells = max_cells;
                 }
                 grown = Some(initial_clustering(grid, sums, &params));
-                &grown.as_ref().expect("just grown").clustering
+                let c = &grown.as_ref().expect("just grown").clustering;
+                (
+                    c.clusters.iter().map(|c| c.cells.as_slice()).collect(),
+                    &c.of_cell,
+                )
             }
         };
         let n = grid.dims();
@@ -89,17 +114,15 @@ impl PolynomialFilter {
             clamp: self.clamp,
         };
         // Each cluster's model, and the per-sample noise variance of its cells.
-        let (fits, noise): (Vec<Fit>, Vec<[f64; 3]>) = clustering
-            .clusters
+        let (fits, noise): (Vec<Fit>, Vec<[f64; 3]>) = cluster_cells
             .par_iter()
             .map(|c| {
                 let cells: Vec<FitCell> = c
-                    .cells
                     .iter()
                     .map(|&i| fit_cell(grid, sums, i as usize))
                     .collect();
                 let fit = Fit::new(&cells, n, &settings);
-                let noise = pooled_noise(sums, &c.cells);
+                let noise = pooled_noise(sums, c);
                 (
                     refit(fit, cells, &noise, n, &settings, self.significance),
                     noise,
@@ -107,15 +130,14 @@ impl PolynomialFilter {
             })
             .unzip();
         let mut fitted = [0u64; MAX_DEGREE as usize + 1];
-        for (c, f) in clustering.clusters.iter().zip(&fits) {
-            if !c.cells.is_empty() && !f.is_empty() {
+        for (c, f) in cluster_cells.iter().zip(&fits) {
+            if !c.is_empty() && !f.is_empty() {
                 fitted[f.degree() as usize] += 1;
             }
         }
         *self.fitted.lock().unwrap_or_else(|e| e.into_inner()) = fitted;
         let (w, h) = film.settings().size();
         let stats = film.pixel_stats();
-        let of_cell = &clustering.of_cell;
         (0..h)
             .into_par_iter()
             .flat_map_iter(|py| {
@@ -371,6 +393,13 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
                 "most cells in one of the fit's own clusters",
             ),
             ParamSpec::new(
+                "noise",
+                ParamType::Float,
+                "0 (off)",
+                "fit clusters merged by noise instead: neighbours whose means agree within this \
+                 many standard errors of their pooled noise",
+            ),
+            ParamSpec::new(
                 "clamp",
                 ParamType::Bool,
                 "true",
@@ -390,7 +419,8 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     let ridge = float_in(p, "ridge", 1e-6, 0.0..=1.0)?;
     let clamp = p.bool_or("clamp", true)?;
     let significance = float_in(p, "significance", 3.0, 0.0..=1e3)?;
-    let mut f = PolynomialFilter::new(degree, ridge, clamp, significance);
+    let mut f = PolynomialFilter::new(degree, ridge, clamp, significance)
+        .with_noise_clusters(float_in(p, "noise", 0.0, 0.0..=1e3)?);
     if p.get("omega").is_some() || p.get("maxclustercells").is_some() {
         let d = ClusterSettings::new(1);
         let omega = float_in(p, "omega", d.omega, 1e-3..=1e3)?;

@@ -1,0 +1,200 @@
+//! Clusters for the fit grown by noise (issue 25): neighbouring cells, then the clusters they
+//! form, merge while their mean luminances agree within their pooled noise,
+//! |m_a - m_b| <= z sqrt(v_a / n_a + v_b / n_b). Noise merges; a step that stands above the
+//! noise does not. No size cap. The sampler's clusters still decide where samples go.
+
+use super::{CellGrid, CellSums};
+
+/// A partition of the cells: each cell's cluster and each cluster's cells.
+#[derive(Clone, Debug, Default)]
+pub struct NoiseClusters {
+    /// Each cell's cluster.
+    pub of_cell: Vec<u32>,
+    /// Each cluster's cells.
+    pub clusters: Vec<Vec<u32>>,
+}
+
+/// Luminance moments of a group of cells: samples, sum, sum of squares.
+#[derive(Clone, Copy, Default)]
+struct Moments {
+    n: f64,
+    sum: f64,
+    sum_sq: f64,
+}
+
+impl Moments {
+    fn mean(&self) -> f64 {
+        self.sum / self.n.max(1.0)
+    }
+
+    /// The variance of the group's mean: its sample variance (with `floor` for groups too
+    /// small to have one) over its count.
+    fn var_of_mean(&self, floor: f64) -> f64 {
+        let v = if self.n >= 2.0 {
+            ((self.sum_sq - self.sum * self.sum / self.n) / (self.n - 1.0)).max(0.0)
+        } else {
+            0.0
+        };
+        v.max(floor) / self.n.max(1.0)
+    }
+}
+
+/// Merges the cells of `grid` by noise at `z` standard errors.
+pub fn grow_by_noise(grid: &CellGrid, sums: &CellSums, z: f64) -> NoiseClusters {
+    let n = grid.len();
+    let moments: Vec<Moments> = (0..n)
+        .map(|i| Moments {
+            n: f64::from(sums.count[i]),
+            sum: sums.lum[i],
+            sum_sq: sums.lum_sq[i],
+        })
+        .collect();
+    // A cell with one sample has no variance of its own: the median of the others' stands in.
+    let mut variances: Vec<f64> = (0..n)
+        .filter(|&i| sums.count[i] >= 2)
+        .map(|i| sums.variance(i))
+        .filter(|v| v.is_finite())
+        .collect();
+    let floor = if variances.is_empty() {
+        0.0
+    } else {
+        let mid = variances.len() / 2;
+        *variances
+            .select_nth_unstable_by(mid, |a, b| a.total_cmp(b))
+            .1
+    };
+    // Face-neighbour pairs, most alike first (their difference in standard errors).
+    let mut pairs: Vec<(f64, u32, u32)> = Vec::new();
+    let mut around = Vec::new();
+    for i in 0..n {
+        grid.neighbours(i, &mut around);
+        for &j in &around {
+            if j <= i {
+                continue;
+            }
+            let (a, b) = (moments[i], moments[j]);
+            let t = if a.n == 0.0 || b.n == 0.0 {
+                0.0 // an empty cell joins a neighbour: it has nothing to say
+            } else {
+                (a.mean() - b.mean()).abs() / (a.var_of_mean(floor) + b.var_of_mean(floor)).sqrt()
+            };
+            if t.is_finite() || a.n == 0.0 || b.n == 0.0 {
+                pairs.push((if t.is_finite() { t } else { 0.0 }, i as u32, j as u32));
+            }
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut group = moments.clone();
+    for &(_, i, j) in &pairs {
+        let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+        if ri == rj {
+            continue;
+        }
+        let (a, b) = (group[ri as usize], group[rj as usize]);
+        let agree = a.n == 0.0
+            || b.n == 0.0
+            || (a.mean() - b.mean()).abs()
+                <= z * (a.var_of_mean(floor) + b.var_of_mean(floor)).sqrt();
+        if agree {
+            parent[rj as usize] = ri;
+            group[ri as usize] = Moments {
+                n: a.n + b.n,
+                sum: a.sum + b.sum,
+                sum_sq: a.sum_sq + b.sum_sq,
+            };
+        }
+    }
+    let mut id_of_root = vec![u32::MAX; n];
+    let mut out = NoiseClusters {
+        of_cell: vec![0; n],
+        clusters: Vec::new(),
+    };
+    for i in 0..n as u32 {
+        let r = find(&mut parent, i) as usize;
+        if id_of_root[r] == u32::MAX {
+            id_of_root[r] = out.clusters.len() as u32;
+            out.clusters.push(Vec::new());
+        }
+        out.of_cell[i as usize] = id_of_root[r];
+        out.clusters[id_of_root[r] as usize].push(i);
+    }
+    out
+}
+
+/// The root of `i`'s set, halving the path on the way.
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let p = parent[i as usize];
+        parent[i as usize] = parent[p as usize];
+        i = p;
+    }
+    i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film::Spectrum;
+    use crate::space::{Dims, RenderingSpace};
+
+    /// A 32 x 16 image of one-pixel cells, 16 samples each of `value(x) + noise` (a fixed
+    /// pseudo-random sequence of unit variance, scaled by `sigma`).
+    fn cells(value: impl Fn(u32) -> f32, sigma: f32) -> (CellGrid, CellSums) {
+        let space = RenderingSpace {
+            x0: 0,
+            x1: 32,
+            y0: 0,
+            y1: 16,
+            dims: Dims::default(),
+        };
+        let grid = CellGrid::new(space, 1.0, 1);
+        let mut sums = CellSums::new(&grid);
+        let mut state = 12345u64;
+        for i in 0..grid.len() {
+            let x = grid.coords(i)[0];
+            for _ in 0..16 {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let u = (state >> 40) as f32 / (1u64 << 24) as f32;
+                let noise = (u - 0.5) * 12f32.sqrt();
+                sums.add(i, &[0.5; 5], Spectrum::splat(value(x) + sigma * noise));
+            }
+        }
+        (grid, sums)
+    }
+
+    #[test]
+    fn noise_merges_and_a_clear_step_does_not() {
+        // Pure noise around a constant: a handful of clusters cover the image.
+        let (grid, sums) = cells(|_| 1.0, 0.3);
+        let flat = grow_by_noise(&grid, &sums, 2.0);
+        assert!(flat.clusters.len() <= 8, "{} clusters", flat.clusters.len());
+        // A step of 1.0 at x = 16 with per-sample noise 0.3 (per-cell standard error 0.075):
+        // no cluster holds cells from both sides.
+        let (grid, sums) = cells(|x| if x < 16 { 1.0 } else { 2.0 }, 0.3);
+        let step = grow_by_noise(&grid, &sums, 2.0);
+        for c in &step.clusters {
+            let sides: Vec<bool> = c.iter().map(|&i| grid.coords(i as usize)[0] < 16).collect();
+            assert!(
+                sides.iter().all(|&s| s == sides[0]),
+                "a cluster straddles the step"
+            );
+        }
+        assert!(
+            step.clusters.len() <= 16,
+            "{} clusters",
+            step.clusters.len()
+        );
+        // Every cell in exactly one cluster, and of_cell agrees.
+        let mut seen = vec![0; grid.len()];
+        for (id, c) in step.clusters.iter().enumerate() {
+            for &i in c {
+                seen[i as usize] += 1;
+                assert_eq!(step.of_cell[i as usize], id as u32);
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1));
+    }
+}
