@@ -342,27 +342,16 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         let [x0, x1, y0, y1] = scene.film.crop;
         FeatureImage::new(x0, x1, y0, y1)
     });
-    let counts = match features.as_mut() {
-        Some(f) => render_with_features(
-            &scene,
-            &plugins.integrator,
-            sampler,
-            &mut film,
-            args.seed,
-            time_limit,
-            bar.as_ref(),
-            f,
-        ),
-        None => render(
-            &scene,
-            &plugins.integrator,
-            sampler,
-            &mut film,
-            args.seed,
-            time_limit,
-            bar.as_ref(),
-        ),
-    };
+    let counts = render_with_features(
+        &scene,
+        &plugins.integrator,
+        sampler,
+        &mut film,
+        args.seed,
+        time_limit,
+        bar.as_ref(),
+        features.as_mut(),
+    );
     if let Some(f) = features.as_ref().filter(|f| f.non_finite > 0) {
         eprintln!(
             "warning: {} samples had non-finite first-hit features; they are left out of the \

@@ -63,11 +63,12 @@ pub fn render(
     time_limit: Option<Duration>,
     progress: Option<&indicatif::ProgressBar>,
 ) -> RenderCounts {
-    let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
-    render_with(scene, &li, sampler, film, seed, time_limit, progress, None)
+    render_with_features(
+        scene, integrator, sampler, film, seed, time_limit, progress, None,
+    )
 }
 
-/// [`render`], also adding each sample's first-hit features to `features`.
+/// [`render`], also adding each sample's first-hit features to `features` when given.
 #[allow(clippy::too_many_arguments)]
 pub fn render_with_features(
     scene: &Scene,
@@ -77,18 +78,11 @@ pub fn render_with_features(
     seed: u64,
     time_limit: Option<Duration>,
     progress: Option<&indicatif::ProgressBar>,
-    features: &mut FeatureImage,
+    features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
     let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
     render_with(
-        scene,
-        &li,
-        sampler,
-        film,
-        seed,
-        time_limit,
-        progress,
-        Some(features),
+        scene, &li, sampler, film, seed, time_limit, progress, features,
     )
 }
 
@@ -107,7 +101,7 @@ impl Traced {
     /// negative, and clamps the rest by the film's limits.
     fn take(
         &mut self,
-        results: &[Traced1],
+        results: &[SampleResult],
         film: &Film,
         counts: &mut RenderCounts,
         mut features: Option<&mut FeatureImage>,
@@ -152,7 +146,7 @@ fn timed<T>(total: &mut Duration, f: impl FnOnce() -> T) -> T {
 pub type Estimator<'a> = dyn Fn(&Scene, Ray, &mut SampleStream) -> Radiance + Sync + 'a;
 
 /// One traced sample: its radiance, rays and first-hit features.
-type Traced1 = (Spectrum, u32, FirstHit);
+type SampleResult = (Spectrum, u32, FirstHit);
 
 /// [`render`] with any estimator in place of an integrator (tests give it one that misbehaves).
 /// Radiance that is NaN, infinite or negative is dropped and counted where it arises; the rest
@@ -176,7 +170,7 @@ pub fn render_with(
     if let Some(p) = progress {
         p.set_length(space.pixels() * u64::from(sampler.spp()));
     }
-    let trace = |batch: &[SamplePoint], results: &mut Vec<Traced1>| {
+    let trace = |batch: &[SamplePoint], results: &mut Vec<SampleResult>| {
         batch
             .par_iter()
             .map(|q| {
@@ -195,7 +189,7 @@ pub fn render_with(
     };
     // Reused from batch to batch: a fresh half-megabyte vector per batch costs page faults.
     let (mut batch, mut next) = (Vec::new(), Vec::new());
-    let mut results: Vec<Traced1> = Vec::new();
+    let mut results: Vec<SampleResult> = Vec::new();
     // The last batch traced, when the sampler and the film have not yet seen it.
     let mut traced = Traced::default();
     let mut pending = false;

@@ -134,6 +134,7 @@ impl Scene {
         let c = &self.light_choice;
         match strategy {
             LightStrategy::Uniform => &c.uniform,
+            // `Bvh` never comes here (choose_light and light_choice_pdf ask the tree).
             LightStrategy::Power | LightStrategy::Bvh => &c.power,
             LightStrategy::Spatial => c
                 .spatial

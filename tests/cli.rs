@@ -1370,20 +1370,22 @@ fn the_comparison_script_writes_its_table_between_the_markers() {
         "report.md",
         "# before\n<!-- versus:begin -->\nold table\n<!-- versus:end -->\nafter\n",
     );
-    let run = Command::new("python3")
-        .arg(root().join("bench/versus.py"))
-        .args([
-            "--acr",
-            env!("CARGO_BIN_EXE_acr"),
-            "--threads",
-            "1",
-            "--scene",
-        ])
-        .arg(&scene)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    // bench/versus.py with this acr on `scene`, and `args`.
+    let versus = |args: &[&OsStr]| {
+        Command::new("python3")
+            .arg(root().join("bench/versus.py"))
+            .args(["--acr", env!("CARGO_BIN_EXE_acr"), "--scene"])
+            .arg(&scene)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let run = versus(&[
+        "--threads".as_ref(),
+        "1".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
     assert!(
         run.status.success(),
         "{}",
@@ -1406,18 +1408,7 @@ fn the_comparison_script_writes_its_table_between_the_markers() {
     assert!(cells[1].parse::<f64>().unwrap() > 0.0, "{row}");
     assert!(cells[2].parse::<f64>().unwrap() > 0.0, "{row}");
     // A binary that is not there is a clear error, not a table.
-    let bad = Command::new("python3")
-        .arg(root().join("bench/versus.py"))
-        .args([
-            "--acr",
-            env!("CARGO_BIN_EXE_acr"),
-            "--pbrt-v4",
-            "/nonexistent/pbrt",
-        ])
-        .arg("--scene")
-        .arg(&scene)
-        .output()
-        .unwrap();
+    let bad = versus(&["--pbrt-v4".as_ref(), "/nonexistent/pbrt".as_ref()]);
     assert!(!bad.status.success());
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(

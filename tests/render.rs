@@ -41,17 +41,20 @@ struct Rendered {
 }
 
 fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> Rendered {
+    render_desc_with(desc, &Overrides::default(), spp, seed)
+}
+
+/// [`render_desc`] with the command line's overrides.
+fn render_desc_with(
+    desc: &SceneDescription,
+    overrides: &Overrides,
+    spp: u32,
+    seed: u64,
+) -> Rendered {
     let mut warnings = Vec::new();
     let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut plugins = choose_for_scene(
-        desc,
-        &scene,
-        &Overrides::default(),
-        Some(spp),
-        seed,
-        &mut warnings,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let mut plugins = choose_for_scene(desc, &scene, overrides, Some(spp), seed, &mut warnings)
+        .unwrap_or_else(|e| panic!("{e}"));
     let mut film = plugins.film(&scene);
     let counts = render(
         &scene,
@@ -210,8 +213,6 @@ fn srgb8_mse(a: &[Spectrum], b: &[Spectrum]) -> f64 {
 
 /// Renders `desc` with the path integrator's light choice set to `strategy`.
 fn render_with_strategy(desc: &SceneDescription, strategy: &str, spp: u32, seed: u64) -> Rendered {
-    let mut warnings = Vec::new();
-    let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
     let overrides = Overrides {
         settings: vec![acr_plugins::Setting::parse(&format!(
             "integrator.lightsamplestrategy={strategy}"
@@ -219,23 +220,7 @@ fn render_with_strategy(desc: &SceneDescription, strategy: &str, spp: u32, seed:
         .unwrap()],
         ..Default::default()
     };
-    let mut plugins = choose_for_scene(desc, &scene, &overrides, Some(spp), seed, &mut warnings)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let mut film = plugins.film(&scene);
-    let counts = render(
-        &scene,
-        &plugins.integrator,
-        plugins.sampler.as_mut(),
-        &mut film,
-        seed,
-        None,
-        None,
-    );
-    Rendered {
-        pixels: plugins.image(&film),
-        width: scene.film.size().0 as usize,
-        dropped: counts.dropped,
-    }
+    render_desc_with(desc, &overrides, spp, seed)
 }
 
 /// The light BVH (the default light choice) keeps the image's expected value: on the room

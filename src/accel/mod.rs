@@ -453,11 +453,7 @@ impl Accel {
             let index = self.tlas_order[id];
             let inst = &self.instances[index as usize];
             let (_, to_local) = inst.placement.at(ray.time);
-            let local = Ray::new(
-                to_local.transform_point3(ray.o),
-                to_local.transform_vector3(ray.d),
-                ray.time,
-            );
+            let local = local_ray(ray, &to_local);
             match self.objects[inst.object as usize].intersect(&local, r.tmax, Some(index)) {
                 Some(h) => {
                     best = Some(h);
@@ -480,11 +476,7 @@ impl Accel {
         !tlas.ray_traverse_miss(to_obvhs(ray, t_max), |_, id| {
             let inst = &self.instances[self.tlas_order[id] as usize];
             let (_, to_local) = inst.placement.at(ray.time);
-            let local = Ray::new(
-                to_local.transform_point3(ray.o),
-                to_local.transform_vector3(ray.d),
-                ray.time,
-            );
+            let local = local_ray(ray, &to_local);
             if self.objects[inst.object as usize].occluded(&local, t_max) {
                 0.0
             } else {
@@ -500,14 +492,19 @@ impl Accel {
         };
         let inst = &self.instances[index as usize];
         let (to_world, to_local) = inst.placement.at(ray.time);
-        let local_ray = Ray::new(
-            to_local.transform_point3(ray.o),
-            to_local.transform_vector3(ray.d),
-            ray.time,
-        );
-        let si = self.objects[inst.object as usize].interaction(&local_ray, hit);
+        let si = self.objects[inst.object as usize].interaction(&local_ray(ray, &to_local), hit);
         transform_interaction(&si, &to_world, &to_local, ray)
     }
+}
+
+/// `ray` in an instance's space.
+#[inline]
+fn local_ray(ray: &Ray, to_local: &Mat4) -> Ray {
+    Ray::new(
+        to_local.transform_point3(ray.o),
+        to_local.transform_vector3(ray.d),
+        ray.time,
+    )
 }
 
 /// Takes an interaction from instance space to the world.
