@@ -706,12 +706,6 @@ impl Bsdf {
         true
     }
 
-    /// Adds a lobe with an RGB weight given first; returns false (and adds nothing) when full.
-    #[inline]
-    pub fn add_weighted(&mut self, scale: Spectrum, bxdf: Bxdf) -> bool {
-        self.add_scaled(bxdf, scale)
-    }
-
     /// Sets the relative index of refraction (inside over outside).
     #[inline]
     pub fn set_eta(&mut self, eta: f32) {

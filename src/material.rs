@@ -224,9 +224,9 @@ impl Material {
                 let sig = sigma.eval(si).clamp(0.0, 90.0);
                 if !is_black(r) {
                     if sig == 0.0 {
-                        b.add_weighted(scale, Bxdf::Lambertian { r });
+                        b.add_scaled(Bxdf::Lambertian { r }, scale);
                     } else {
-                        b.add_weighted(scale, Bxdf::oren_nayar(r, sig));
+                        b.add_scaled(Bxdf::oren_nayar(r, sig), scale);
                     }
                 }
             }
@@ -238,13 +238,12 @@ impl Material {
             } => {
                 let kd = clamp0(kd.eval(si));
                 if !is_black(kd) {
-                    b.add_weighted(scale, Bxdf::Lambertian { r: kd });
+                    b.add_scaled(Bxdf::Lambertian { r: kd }, scale);
                 }
                 let ks = clamp0(ks.eval(si));
                 if !is_black(ks) {
                     let rough = roughness.eval(si);
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::MicrofacetReflection {
                             r: ks,
                             distribution: distribution(rough, rough, *remap_roughness),
@@ -254,18 +253,19 @@ impl Material {
                                 eta_t: 1.0,
                             },
                         },
+                        scale,
                     );
                 }
             }
             Material::Mirror { kr } => {
                 let r = clamp0(kr.eval(si));
                 if !is_black(r) {
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::SpecularReflection {
                             r,
                             fresnel: Fresnel::NoOp,
                         },
+                        scale,
                     );
                 }
             }
@@ -289,14 +289,14 @@ impl Material {
                 }
                 let specular = urough == 0.0 && vrough == 0.0;
                 if specular && allow_multiple_lobes {
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::FresnelSpecular {
                             r,
                             t,
                             eta_a: 1.0,
                             eta_b: eta,
                         },
+                        scale,
                     );
                     return;
                 }
@@ -306,8 +306,7 @@ impl Material {
                         eta_i: 1.0,
                         eta_t: eta,
                     };
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         if specular {
                             Bxdf::SpecularReflection { r, fresnel }
                         } else {
@@ -317,11 +316,11 @@ impl Material {
                                 fresnel,
                             }
                         },
+                        scale,
                     );
                 }
                 if !is_black(t) {
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         if specular {
                             Bxdf::SpecularTransmission {
                                 t,
@@ -336,6 +335,7 @@ impl Material {
                                 eta_b: eta,
                             }
                         },
+                        scale,
                     );
                 }
             }
@@ -353,8 +353,7 @@ impl Material {
                 let v = v_roughness
                     .as_ref()
                     .map_or_else(|| roughness.eval(si), |t| t.eval(si));
-                b.add_weighted(
-                    scale,
+                b.add_scaled(
                     Bxdf::MicrofacetReflection {
                         r: Spectrum::ONE,
                         distribution: distribution(u, v, *remap_roughness),
@@ -364,6 +363,7 @@ impl Material {
                             k: k.eval(si),
                         },
                     },
+                    scale,
                 );
             }
             Material::Uber {
@@ -382,20 +382,20 @@ impl Material {
                 let op = clamp0(opacity.eval(si));
                 let t = clamp0(Spectrum::ONE - op);
                 if !is_black(t) {
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::SpecularTransmission {
                             t,
                             eta_a: 1.0,
                             eta_b: 1.0,
                         },
+                        scale,
                     );
                 } else if first {
                     b.set_eta(e);
                 }
                 let kd = op * clamp0(kd.eval(si));
                 if !is_black(kd) {
-                    b.add_weighted(scale, Bxdf::Lambertian { r: kd });
+                    b.add_scaled(Bxdf::Lambertian { r: kd }, scale);
                 }
                 let ks = op * clamp0(ks.eval(si));
                 if !is_black(ks) {
@@ -403,8 +403,7 @@ impl Material {
                         .as_ref()
                         .map_or_else(|| roughness.eval(si), |t| t.eval(si));
                     let v = v_roughness.as_ref().map_or(u, |t| t.eval(si));
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::MicrofacetReflection {
                             r: ks,
                             distribution: distribution(u, v, *remap_roughness),
@@ -413,12 +412,12 @@ impl Material {
                                 eta_t: e,
                             },
                         },
+                        scale,
                     );
                 }
                 let kr = op * clamp0(kr.eval(si));
                 if !is_black(kr) {
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::SpecularReflection {
                             r: kr,
                             fresnel: Fresnel::Dielectric {
@@ -426,17 +425,18 @@ impl Material {
                                 eta_t: e,
                             },
                         },
+                        scale,
                     );
                 }
                 let kt = op * clamp0(kt.eval(si));
                 if !is_black(kt) {
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::SpecularTransmission {
                             t: kt,
                             eta_a: 1.0,
                             eta_b: e,
                         },
+                        scale,
                     );
                 }
             }
@@ -451,13 +451,13 @@ impl Material {
                 let s = clamp0(ks.eval(si));
                 if !is_black(d) || !is_black(s) {
                     let (u, v) = (u_roughness.eval(si), v_roughness.eval(si));
-                    b.add_weighted(
-                        scale,
+                    b.add_scaled(
                         Bxdf::FresnelBlend {
                             rd: d,
                             rs: s,
                             distribution: distribution(u, v, *remap_roughness),
                         },
+                        scale,
                     );
                 }
             }

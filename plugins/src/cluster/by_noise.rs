@@ -78,8 +78,8 @@ pub fn grow_by_noise(grid: &CellGrid, sums: &CellSums, z: f64) -> NoiseClusters 
             } else {
                 (a.mean() - b.mean()).abs() / (a.var_of_mean(floor) + b.var_of_mean(floor)).sqrt()
             };
-            if t.is_finite() || a.n == 0.0 || b.n == 0.0 {
-                pairs.push((if t.is_finite() { t } else { 0.0 }, i as u32, j as u32));
+            if t.is_finite() {
+                pairs.push((t, i as u32, j as u32));
             }
         }
     }
