@@ -32,11 +32,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN, END = "<!-- versus:begin -->", "<!-- versus:end -->"
 
 
-def run(cmd, cwd=None):
+def run(cmd):
     """Runs cmd to completion: (seconds, peak RSS in MiB, exit status, stderr tail)."""
     with tempfile.TemporaryFile() as err:
         start = time.perf_counter()
-        proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=err)
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
         _, status, usage = os.wait4(proc.pid, 0)
         seconds = time.perf_counter() - start
         proc.returncode = os.waitstatus_to_exitcode(status)
@@ -91,11 +91,11 @@ def with_spp(scene, spp):
     return path
 
 
-def measure(label, cmd, runs, cwd=None):
+def measure(label, cmd, runs):
     """Median seconds and peak MiB over `runs` runs, or a failure note."""
     times, peaks = [], []
     for _ in range(runs):
-        seconds, peak, code, tail = run(cmd, cwd)
+        seconds, peak, code, tail = run(cmd)
         if code != 0:
             print(f"  {label} failed ({code}): {tail}", file=sys.stderr)
             return None
