@@ -86,9 +86,12 @@ def upgraded(pbrt_v4, scene):
 def v4_work(original, v4):
     """acr's arguments for the work pbrt-v4 does on the upgraded scene `v4` when the upgrade
     changed the integrator (pbrt-v3's directlighting becomes path); None when it did not."""
-    if not re.search(r'Integrator\s+"directlighting"', inlined(original, os.path.dirname(original))):
+    # Directives at the start of a line: "##Integrator ..." is a comment.
+    scene = inlined(original, os.path.dirname(original))
+    if not re.search(r'^\s*Integrator\s+"directlighting"', scene, re.MULTILINE):
         return None
-    found = re.search(r'Integrator\s+"path"\s+"integer maxdepth"\s*\[\s*(\d+)', open(v4).read())
+    found = re.search(r'^\s*Integrator\s+"path"\s+"integer maxdepth"\s*\[\s*(\d+)',
+                      open(v4).read(), re.MULTILINE)
     depth = found.group(1) if found else "5"
     return ["--integrator", "path", "--set", f"integrator.maxdepth={depth}"]
 
