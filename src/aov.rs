@@ -14,7 +14,15 @@ use acr_plugins::{Partition, PixelStats};
 use std::path::{Path, PathBuf};
 
 /// The AOVs acr writes.
-pub const AOV_NAMES: &[&str] = &["spp", "variance", "clusters", "albedo", "normal", "depth"];
+pub const AOV_NAMES: &[&str] = &[
+    "spp",
+    "variance",
+    "clusters",
+    "fitclusters",
+    "albedo",
+    "normal",
+    "depth",
+];
 
 /// The AOVs made of first-hit features (the render collects them only when one is asked for).
 pub const FEATURE_AOVS: &[&str] = &["albedo", "normal", "depth"];
@@ -97,10 +105,15 @@ pub fn write_aov(
     height: usize,
     stats: &[PixelStats],
     partition: Option<&Partition>,
+    fit_partition: Option<&Partition>,
     features: Option<&FeatureImage>,
 ) -> Result<String, String> {
     if req.name == "clusters" {
         let p = partition.ok_or("--aov clusters: the sampler made no clusters")?;
+        return write_clusters(req, p);
+    }
+    if req.name == "fitclusters" {
+        let p = fit_partition.ok_or("--aov fitclusters: the filter fitted no clusters")?;
         return write_clusters(req, p);
     }
     let values = if req.is_feature() {

@@ -824,10 +824,21 @@ fn csv_field(s: &str) -> String {
     }
 }
 
+/// The image's mean over the reference's (1 when the reference is black): a filter or sampler
+/// that moves the mean shows here whatever its MSE.
+fn mean_ratio(m: &crate::metrics::Metrics) -> f64 {
+    if m.reference_mean > 0.0 {
+        m.mean / m.reference_mean
+    } else {
+        1.0
+    }
+}
+
 /// The CSV: one row per run, failed runs with their reason.
 pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
     let mut s = String::from(
-        "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status\n",
+        "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
+         mean_ratio\n",
     );
     for r in rows {
         let head = format!(
@@ -841,18 +852,19 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
             Ok(m) => {
                 let _ = writeln!(
                     s,
-                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok",
+                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok,{:.5}",
                     m.seconds,
                     m.samples,
                     m.spp_reached,
                     m.metrics.mse,
                     m.metrics.relmse,
                     m.metrics.psnr,
-                    m.peak_rss_mb
+                    m.peak_rss_mb,
+                    mean_ratio(&m.metrics)
                 );
             }
             Err(e) => {
-                let _ = writeln!(s, "{head},,,,,,,,{}", csv_field(&format!("failed: {e}")));
+                let _ = writeln!(s, "{head},,,,,,,,{},", csv_field(&format!("failed: {e}")));
             }
         }
     }
@@ -927,9 +939,9 @@ pub fn report_markdown(
         let _ = writeln!(s, "![{0}]({0}.png)\n", file_safe(&scene.name));
         let _ = writeln!(
             s,
-            "| spp | method | seconds | MSE | relMSE | MSE ratio | relMSE ratio | equal-time seconds | equal-time spp | equal-time MSE | MSE ratio | relMSE ratio |"
+            "| spp | method | seconds | MSE | relMSE | MSE ratio | relMSE ratio | mean / reference | equal-time seconds | equal-time spp | equal-time MSE | MSE ratio | relMSE ratio |"
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         for &spp in &m.budgets.spp {
             let base = find(rows, &scene.name, &m.methods[0].label, spp, Mode::EqualSpp)
                 .and_then(|r| r.outcome.as_ref().ok());
@@ -941,16 +953,17 @@ pub fn report_markdown(
                     Some(Ok(r)) => {
                         let _ = write!(
                             line,
-                            "| {:.3} | {:.3e} | {:.3e} | {} | {} ",
+                            "| {:.3} | {:.3e} | {:.3e} | {} | {} | {:.4} ",
                             r.seconds,
                             r.metrics.mse,
                             r.metrics.relmse,
                             ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
-                            ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse))
+                            ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse)),
+                            mean_ratio(&r.metrics)
                         );
                     }
-                    Some(Err(_)) => line.push_str("| failed | | | | "),
-                    None => line.push_str("| | | | | "),
+                    Some(Err(_)) => line.push_str("| failed | | | | | "),
+                    None => line.push_str("| | | | | | "),
                 }
                 match et.map(|r| &r.outcome) {
                     Some(Ok(r)) => {

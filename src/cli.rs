@@ -89,7 +89,7 @@ pub struct RenderArgs {
     #[arg(long = "set", value_name = "KIND.PARAM=VALUE")]
     pub set: Vec<String>,
     /// Extra per-pixel outputs, NAME=FILE[,NAME=FILE]: spp (samples per pixel), variance (of
-    /// each pixel's mean), clusters (cluster sampler), albedo, normal, depth (means of the
+    /// each pixel's mean), clusters (cluster sampler), fitclusters (the clusters the polynomial filter fitted), albedo, normal, depth (means of the
     /// first-hit features, .exr or .pfm). An .exr holds the values; a .png is false colour
     /// scaled by the largest value (the scale is printed and stored in the PNG). Repeatable.
     #[arg(long, value_name = "NAME=FILE")]
@@ -385,6 +385,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         pixels: plugins.image(&film),
     };
     let t_reconstructed = Instant::now();
+    let fit_partition = plugins.filter.fit_partition();
     write_image(&output, &image).map_err(|e| format!("{}: {e}", output.display()))?;
     for a in &aovs {
         let line = write_aov(
@@ -393,6 +394,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             h as usize,
             film.pixel_stats(),
             plugins.sampler.partition(),
+            fit_partition.as_ref(),
             features.as_ref(),
         )?;
         if !args.quiet {

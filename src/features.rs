@@ -19,6 +19,12 @@ pub struct FirstHit {
 }
 
 impl FirstHit {
+    /// The features as the film's cells take them: albedo, normal, depth.
+    pub fn to_array(&self) -> acr_plugins::first_hit::Features {
+        let (a, n) = (self.albedo, self.normal);
+        [a.x, a.y, a.z, n.x, n.y, n.z, self.depth]
+    }
+
     /// Whether every value is finite.
     pub fn is_finite(&self) -> bool {
         self.albedo.is_finite() && self.normal.is_finite() && self.depth.is_finite()

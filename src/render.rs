@@ -8,6 +8,7 @@ use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
 use crate::integrator::{Integrator, Radiance};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
+use acr_plugins::first_hit::{sanitized, Features};
 use acr_plugins::sampler::SOBOL_DIMS_USED;
 use acr_plugins::{Film, RenderingSpace, SamplePoint, Sampler};
 use rayon::prelude::*;
@@ -50,6 +51,8 @@ pub struct RenderCounts {
     pub halted: bool,
     /// Wall seconds spent in the sampler (its batches and what it learns from them).
     pub sampler_seconds: f64,
+    /// Samples whose first-hit features were not finite (set to 0 for the film's cells).
+    pub non_finite_features: u64,
 }
 
 /// Renders `scene` with `sampler`'s points into `film`, until the sampler's budget is spent
@@ -94,6 +97,9 @@ struct Traced {
     radiance: Vec<[f32; 3]>,
     /// The film position and radiance of each sample kept.
     valid: Vec<(Vec2, Spectrum)>,
+    /// Each point's first-hit features, for the film's cells (values that are not finite
+    /// become 0 and are counted).
+    features: Vec<Features>,
 }
 
 impl Traced {
@@ -108,8 +114,12 @@ impl Traced {
     ) {
         self.valid.clear();
         self.radiance.clear();
+        self.features.clear();
         for (q, &(l, rays, first_hit)) in self.batch.iter().zip(results) {
             counts.rays += u64::from(rays);
+            let (f, bad) = sanitized(first_hit.to_array());
+            counts.non_finite_features += u64::from(bad);
+            self.features.push(f);
             if let Some(f) = features.as_deref_mut() {
                 f.add(Vec2::from(q.film), &first_hit);
             }
@@ -129,7 +139,7 @@ impl Traced {
     /// Gives the batch to the sampler (its time added to `in_sampler`), then to the film.
     fn hand_over(&self, sampler: &mut dyn Sampler, film: &mut Film, in_sampler: &mut Duration) {
         timed(in_sampler, || sampler.observe(&self.batch, &self.radiance));
-        film.add_points(&self.batch, &self.radiance);
+        film.add_points(&self.batch, &self.radiance, Some(&self.features));
         film.add_samples(&self.valid);
     }
 }

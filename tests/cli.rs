@@ -1198,13 +1198,14 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(
         lines[0],
-        "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status"
+        "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
+         mean_ratio"
     );
     assert_eq!(lines.len(), 11);
     let ok: Vec<&str> = lines[1..]
         .iter()
         .copied()
-        .filter(|l| l.ends_with(",ok"))
+        .filter(|l| l.contains(",ok,"))
         .collect();
     assert_eq!(ok.len(), 6, "{csv}");
     assert!(lines
@@ -1226,6 +1227,9 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
             field(eq(m, "4"), 7) < field(eq(m, "1"), 7),
             "{m}: MSE falls"
         );
+        // The image mean over the reference's: near 1 for an unbiased method.
+        let mean = field(eq(m, "4"), 12);
+        assert!((mean - 1.0).abs() < 0.05, "{m}: mean ratio {mean}");
     }
     let plot = std::fs::read(out.join("small.png")).unwrap();
     assert!(plot.len() > 1000 && plot.starts_with(b"\x89PNG"));
@@ -1439,6 +1443,76 @@ fn feature_scene(mirror: bool) -> String {
               \"point3 P\" [-9 -9 -3  9 -9 -3  9 9 -3  -9 9 -3]\n";
     }
     s + "WorldEnd\n"
+}
+
+/// `--aov fitclusters`: the polynomial filter's fitted clusters, as ids per pixel. With the
+/// first-hit features, no cluster straddles the edge between two albedos; a filter that fits
+/// nothing is told so.
+#[test]
+fn the_fit_clusters_follow_an_albedo_edge() {
+    let dir = TempDir::new("fitclusters");
+    let scene = dir.write(
+        "halves.pbrt",
+        "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
+         Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16\n\
+         Sampler \"random\" \"integer pixelsamples\" 16\nWorldBegin\n\
+         LightSource \"distant\" \"point from\" [0 0 0] \"point to\" [0 0 1] \"rgb L\" [3 3 3]\n\
+         AttributeBegin\nMaterial \"matte\" \"rgb Kd\" [0.2 0.2 0.2]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
+         \"point3 P\" [-9 -9 4  0 -9 4  0 9 4  -9 9 4]\nAttributeEnd\n\
+         Material \"matte\" \"rgb Kd\" [0.8 0.8 0.8]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
+         \"point3 P\" [0 -9 4  9 -9 4  9 9 4  0 9 4]\nWorldEnd\n",
+    );
+    let ids = dir.join("ids.exr");
+    let aov = format!("fitclusters={}", ids.display());
+    let out = dir.join("o.exr");
+    let args = [
+        "--filter",
+        "polynomial",
+        "--set",
+        "filter.features=true",
+        "--aov",
+        &aov,
+    ];
+    render_ok(&scene, &out, &args);
+    let ids = read_image(&ids, false).unwrap();
+    let image = read_image(&out, false).unwrap();
+    let id = |x: usize, y: usize| ids.pixels[y * 16 + x].x;
+    let mut found = std::collections::BTreeSet::new();
+    for y in 0..16 {
+        for x in 0..16 {
+            let v = id(x, y);
+            assert!(v >= 0.0 && v.fract() == 0.0, "id {v}");
+            found.insert(v as u32);
+        }
+    }
+    // The two albedos' sides, told apart by the image (which side is brighter).
+    let left = image.pixels[8 * 16 + 2].x < image.pixels[8 * 16 + 13].x;
+    let dark = |x: usize| (x < 8) == left;
+    let side = |want: bool| -> std::collections::BTreeSet<u32> {
+        (0..256)
+            .filter(|i| dark(i % 16) == want)
+            .map(|i| id(i % 16, i / 16) as u32)
+            .collect()
+    };
+    let (d, b) = (side(true), side(false));
+    assert!(
+        d.is_disjoint(&b),
+        "a cluster straddles the edge: {d:?} {b:?}"
+    );
+    // Noise merges: far fewer clusters than pixels.
+    assert!(
+        found.len() >= 2 && found.len() <= 32,
+        "{} clusters",
+        found.len()
+    );
+    render_fails(
+        &scene,
+        &out,
+        &["--filter", "box", "--aov", &aov],
+        "the filter fitted no clusters",
+    );
 }
 
 /// `--aov albedo,normal,depth`: the first non-specular surface's albedo, normal (facing the

@@ -5,19 +5,13 @@
 
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
-use crate::filters::FilterKernel;
+use crate::first_hit::Features;
+use crate::kernel::FilterKernel;
 use crate::space::SamplePoint;
 use acr_parser::{Error, PluginDesc, Result};
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 
-/// Linear RGB radiance.
-pub type Spectrum = Vec3;
-
-/// Luminance of linear RGB (pbrt's y(): Rec. 709 weights).
-#[inline]
-pub fn luminance(c: Spectrum) -> f32 {
-    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
-}
+pub use crate::color::{luminance, Spectrum};
 
 /// Entries per axis of the filter table (pbrt-v3's filterTableWidth).
 const TABLE_SIZE: usize = 16;
@@ -391,20 +385,28 @@ impl Film {
         }
     }
 
-    /// Makes the film also keep running sums per cell of `grid` ([`Film::add_points`]).
-    pub fn collect_cells(&mut self, grid: CellGrid) {
+    /// Makes the film also keep running sums per cell of `grid` ([`Film::add_points`]), with
+    /// the samples' first-hit features when `features`.
+    pub fn collect_cells(&mut self, grid: CellGrid, features: bool) {
         let sums = CellSums::new(&grid);
+        let sums = if features { sums.with_features() } else { sums };
         self.cells = Some((grid, sums));
     }
 
-    /// Adds each point of `batch` with its radiance to its cell, when the film collects cells;
-    /// NaN radiance marks a dropped sample and is skipped.
-    pub fn add_points(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+    /// Adds each point of `batch` with its radiance (and first-hit features, when given) to
+    /// its cell, when the film collects cells; NaN radiance marks a dropped sample and is
+    /// skipped.
+    pub fn add_points(
+        &mut self,
+        batch: &[SamplePoint],
+        radiance: &[[f32; 3]],
+        features: Option<&[Features]>,
+    ) {
         let Some((grid, sums)) = self.cells.as_mut() else {
             return;
         };
         grid.locate_all(batch, &mut self.located);
-        sums.add_batch(&self.located, radiance);
+        sums.add_batch(&self.located, radiance, features);
     }
 
     /// The film's cells, when it collects them.

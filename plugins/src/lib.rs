@@ -3,8 +3,11 @@
 //! plugin is testable on analytic integrands.
 
 pub mod cluster;
+pub mod color;
 pub mod film;
 pub mod filters;
+pub mod first_hit;
+pub mod kernel;
 pub mod partition;
 pub mod registry;
 pub mod regression;

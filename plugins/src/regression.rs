@@ -11,6 +11,13 @@
 //! exactly from any number of samples per cell (at the centroid alone it is off by the
 //! samples' variance times the curvature).
 //!
+//! With features on, the model also has a linear term per first-hit feature (albedo, normal,
+//! depth: `crate::first_hit`) that varies over the cluster, `+ Σ_j b_j (f_j - μ_j) / σ_j`,
+//! the cell's row holding its mean features: a first-order feature regression per cluster,
+//! so that a texture or an edge inside the cluster is explained by the albedo or the normal
+//! instead of smoothed away. A feature term is used only where the cluster has at least twice
+//! as many sampled cells as the model has terms.
+//!
 //! Stability: coordinates centred and scaled to the cluster; a ridge scaled to the normal
 //! matrix's trace (never on the constant); a dim with fewer distinct cell positions than its
 //! degree needs loses degree; a failed or ill-conditioned Cholesky falls back one degree at a
@@ -21,12 +28,25 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::cluster::grid::MAX_DIMS;
+use crate::first_hit::FEATURES;
 
 /// Highest degree of the model.
 pub const MAX_DEGREE: u32 = 2;
 
-/// Coefficients of one fit: the constant and up to `MAX_DEGREE` per dim.
-const MAX_TERMS: usize = 1 + MAX_DIMS * MAX_DEGREE as usize;
+/// Coefficients of one fit: the constant, up to `MAX_DEGREE` per dim, and one per feature.
+const MAX_TERMS: usize = 1 + MAX_DIMS * MAX_DEGREE as usize + FEATURES;
+
+/// A feature's term in the model: `b (f - centre) / scale`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct FeatureTerm {
+    feature: usize,
+    centre: f64,
+    scale: f64,
+}
+
+/// A feature whose weighted standard deviation over the cluster is below this (relative to
+/// its scale: 1 for albedo and normal, the mean for depth) has no term.
+const FEATURE_SPREAD_FLOOR: f64 = 1e-3;
 
 /// A pivot below this fraction of the largest diagonal entry means the system is singular
 /// for the degree tried.
@@ -45,6 +65,8 @@ pub struct FitCell {
     pub m2: [f64; MAX_DIMS],
     /// Mean radiance of its samples.
     pub mean: [f64; 3],
+    /// Mean first-hit features of its samples (zeros when not kept).
+    pub features: [f64; FEATURES],
     /// Its weight (sample count); 0 for a cell without samples, which only needs a value.
     pub weight: f64,
 }
@@ -58,6 +80,8 @@ pub struct FitSettings {
     pub ridge: f64,
     /// Clamp values to the range of the cluster's cell means.
     pub clamp: bool,
+    /// Regress on the cells' first-hit features too.
+    pub features: bool,
 }
 
 /// One cluster's fitted model.
@@ -67,7 +91,9 @@ pub struct Fit {
     centre: [f64; MAX_DIMS],
     half: [f64; MAX_DIMS],
     degree: [u32; MAX_DIMS],
-    /// a0, then each dim's a_d1..a_d(deg_d), per channel.
+    /// The features with a term: each one's index, centre and scale.
+    feature_terms: Vec<FeatureTerm>,
+    /// a0, then each dim's a_d1..a_d(deg_d), then each feature term's, per channel.
     coeffs: Vec<[f64; 3]>,
     lo: [f64; 3],
     hi: [f64; 3],
@@ -107,6 +133,41 @@ fn legendre_means(a: f64, b: f64) -> [f64; MAX_DEGREE as usize] {
     out
 }
 
+/// The features that vary over the usable cells, with their weighted mean and standard
+/// deviation: each becomes a term `(f - mean) / sd`.
+fn feature_terms(cells: &[FitCell], usable: &dyn Fn(&FitCell) -> bool) -> Vec<FeatureTerm> {
+    let (mut w, mut s1, mut s2) = (0.0, [0.0f64; FEATURES], [0.0f64; FEATURES]);
+    for c in cells.iter().filter(|c| usable(c)) {
+        if c.features.iter().any(|v| !v.is_finite()) {
+            return Vec::new();
+        }
+        w += c.weight;
+        for f in 0..FEATURES {
+            s1[f] += c.weight * c.features[f];
+            s2[f] += c.weight * c.features[f] * c.features[f];
+        }
+    }
+    if w <= 0.0 {
+        return Vec::new();
+    }
+    (0..FEATURES)
+        .filter_map(|f| {
+            let mean = s1[f] / w;
+            let sd = (s2[f] / w - mean * mean).max(0.0).sqrt();
+            let scale = if f == crate::first_hit::DEPTH {
+                mean.abs()
+            } else {
+                1.0
+            };
+            (sd > FEATURE_SPREAD_FLOOR * scale && sd.is_finite()).then_some(FeatureTerm {
+                feature: f,
+                centre: mean,
+                scale: sd,
+            })
+        })
+        .collect()
+}
+
 impl Fit {
     /// Fits the cluster made of `cells` over the first `dims` dims.
     pub fn new(cells: &[FitCell], dims: usize, settings: &FitSettings) -> Self {
@@ -116,6 +177,7 @@ impl Fit {
             centre: [0.0; MAX_DIMS],
             half: [1.0; MAX_DIMS],
             degree: [0; MAX_DIMS],
+            feature_terms: Vec::new(),
             coeffs: vec![[0.0; 3]],
             lo: [f64::INFINITY; 3],
             hi: [0.0; 3],
@@ -169,22 +231,48 @@ impl Fit {
             starts.dedup();
             degree[d] = want.min(starts.len().saturating_sub(1) as u32);
         }
-        // Fall back one degree at a time until the system is well posed.
-        let mut cap = want;
-        while cap > 0 {
-            let deg = degree.map(|g| g.min(cap));
-            if deg.iter().all(|&g| g == 0) {
-                break;
+        let features = if settings.features {
+            feature_terms(cells, &usable)
+        } else {
+            Vec::new()
+        };
+        let sampled = cells.iter().filter(|c| usable(c)).count();
+        // Fall back one degree at a time until the system is well posed, at each degree first
+        // with the feature terms (when the cluster has cells enough for them), then without.
+        for cap in (0..=want).rev() {
+            fit.degree = degree.map(|g| g.min(cap));
+            let poly_terms = fit.terms();
+            let with = (!features.is_empty() && sampled >= 2 * (poly_terms + features.len()))
+                .then_some(features.clone());
+            for terms in with.into_iter().chain([Vec::new()]) {
+                if terms.is_empty() && poly_terms == 1 {
+                    continue; // the weighted mean, below
+                }
+                fit.feature_terms = terms;
+                loop {
+                    match fit.solve(cells, settings.ridge, &usable) {
+                        Ok(coeffs) => {
+                            fit.coeffs = coeffs;
+                            return fit;
+                        }
+                        // A feature term that repeats another (grey albedo: three equal
+                        // channels) or a coordinate: drop that term, keep the others.
+                        Err(Some(j)) if j >= poly_terms && !fit.feature_terms.is_empty() => {
+                            fit.feature_terms.remove(j - poly_terms);
+                        }
+                        Err(_) => break,
+                    }
+                }
             }
-            fit.degree = deg;
-            if let Some(coeffs) = fit.solve(cells, settings.ridge, &usable) {
-                fit.coeffs = coeffs;
-                return fit;
-            }
-            cap -= 1;
         }
         fit.degree = [0; MAX_DIMS];
+        fit.feature_terms.clear();
         fit
+    }
+
+    /// Features with a term in the last fit (indices into the cell's features).
+    pub fn feature_terms(&self) -> impl Iterator<Item = usize> + '_ {
+        self.feature_terms.iter().map(|t| t.feature)
     }
 
     /// Terms of the model (the constant included).
@@ -193,6 +281,7 @@ impl Fit {
             .iter()
             .map(|&g| g as usize)
             .sum::<usize>()
+            + self.feature_terms.len()
     }
 
     /// The row of cell `c`: the mean of each basis function over its samples.
@@ -214,15 +303,19 @@ impl Fit {
             }
             t += self.degree[d] as usize;
         }
+        for (k, term) in self.feature_terms.iter().enumerate() {
+            row[t + k] = (c.features[term.feature] - term.centre) / term.scale;
+        }
     }
 
-    /// Weighted least squares with a ridge by Cholesky; None when a pivot collapses.
+    /// Weighted least squares with a ridge by Cholesky; the term whose pivot collapses when
+    /// one does (None: the solution was not finite).
     fn solve(
         &self,
         cells: &[FitCell],
         ridge: f64,
         usable: &dyn Fn(&FitCell) -> bool,
-    ) -> Option<Vec<[f64; 3]>> {
+    ) -> Result<Vec<[f64; 3]>, Option<usize>> {
         let m = self.terms();
         let mut a = [[0.0f64; MAX_TERMS]; MAX_TERMS];
         let mut b = [[0.0f64; 3]; MAX_TERMS];
@@ -252,7 +345,7 @@ impl Fit {
                 d -= a[j][k] * a[j][k];
             }
             if d.is_nan() || d <= PIVOT_FLOOR * largest {
-                return None;
+                return Err(Some(j));
             }
             let d = d.sqrt();
             a[j][j] = d;
@@ -285,7 +378,11 @@ impl Fit {
                 x[i][ch] = s / a[i][i];
             }
         }
-        x.iter().flatten().all(|v| v.is_finite()).then_some(x)
+        if x.iter().flatten().all(|v| v.is_finite()) {
+            Ok(x)
+        } else {
+            Err(None)
+        }
     }
 
     /// Whether the cluster had no usable sample (its values are then 0 and mean nothing).
@@ -303,9 +400,15 @@ impl Fit {
         &self.coeffs
     }
 
-    /// The model's mean over the box `[lo, hi]` (closed form), clamped as set, never
-    /// negative, never NaN.
-    pub fn mean_over(&self, lo: &[f64; MAX_DIMS], hi: &[f64; MAX_DIMS]) -> [f64; 3] {
+    /// The model's mean over the box `[lo, hi]` of a cell whose mean features are `features`
+    /// (closed form; None: the cluster's mean features), clamped as set, never negative,
+    /// never NaN.
+    pub fn mean_over(
+        &self,
+        lo: &[f64; MAX_DIMS],
+        hi: &[f64; MAX_DIMS],
+        features: Option<&[f64; FEATURES]>,
+    ) -> [f64; 3] {
         let mut v = self.coeffs[0];
         let mut t = 1;
         for d in 0..self.dims {
@@ -322,6 +425,15 @@ impl Fit {
                 }
             }
             t += g;
+        }
+        for (k, term) in self.feature_terms.iter().enumerate() {
+            // No features: the cluster's mean features, where every term is 0.
+            let x = features.map_or(0.0, |fs| (fs[term.feature] - term.centre) / term.scale);
+            if x.is_finite() {
+                for (ch, out) in v.iter_mut().enumerate() {
+                    *out += self.coeffs[t + k][ch] * x;
+                }
+            }
         }
         std::array::from_fn(|ch| self.limit(ch, v[ch]))
     }

@@ -56,14 +56,14 @@ fn render(mut s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
     let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
     if let Some((cell_size, bins)) = f.cell_layout() {
         if !s.keeps_cells() {
-            film.collect_cells(CellGrid::new(space(), cell_size, bins));
+            film.collect_cells(CellGrid::new(space(), cell_size, bins), false);
         }
     }
     let mut batch = Vec::new();
     while s.next_batch(&mut batch) {
         let radiance: Vec<[f32; 3]> = batch.iter().map(|q| [field(q); 3]).collect();
         s.observe(&batch, &radiance);
-        film.add_points(&batch, &radiance);
+        film.add_points(&batch, &radiance, None);
         let samples: Vec<(Vec2, Vec3)> = batch
             .iter()
             .zip(&radiance)

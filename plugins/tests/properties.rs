@@ -135,6 +135,7 @@ fn clusters() -> impl Strategy<Value = (Vec<FitCell>, usize)> {
                         m1: [0.5; MAX_DIMS],
                         m2: [1.0 / 3.0; MAX_DIMS],
                         mean: [mean[0], mean[1], mean[2]],
+                        features: [0.0; 7],
                         weight,
                     };
                     for d in 0..MAX_DIMS {
@@ -173,7 +174,7 @@ proptest! {
         ridge in prop_oneof![Just(0.0), 1e-9f64..1e-1],
         clamp in any::<bool>(),
     ) {
-        let fit = Fit::new(&cells, dims, &FitSettings { degree, ridge, clamp });
+        let fit = Fit::new(&cells, dims, &FitSettings { degree, ridge, clamp, features: false });
         let usable: Vec<&FitCell> = cells
             .iter()
             .filter(|c| c.weight > 0.0 && c.mean.iter().all(|v| v.is_finite()))
@@ -185,7 +186,7 @@ proptest! {
         boxes.push(([-3.0; MAX_DIMS], [7.0; MAX_DIMS]));
         boxes.push(([0.5; MAX_DIMS], [0.5; MAX_DIMS]));
         for (lo, hi) in &boxes {
-            let v = fit.mean_over(lo, hi);
+            let v = fit.mean_over(lo, hi, None);
             for ch in 0..3 {
                 prop_assert!(v[ch].is_finite() && v[ch] >= 0.0, "value {:?}", v);
                 if clamp && !usable.is_empty() {
@@ -203,9 +204,9 @@ proptest! {
             .iter()
             .map(|c| FitCell { mean: [0.25, 0.5, 3.0], weight: c.weight.max(1.0), ..*c })
             .collect();
-        let fit = Fit::new(&constant, dims, &FitSettings { degree, ridge, clamp });
+        let fit = Fit::new(&constant, dims, &FitSettings { degree, ridge, clamp, features: false });
         for (lo, hi) in &boxes[..cells.len()] {
-            let v = fit.mean_over(lo, hi);
+            let v = fit.mean_over(lo, hi, None);
             for (ch, want) in [0.25, 0.5, 3.0].into_iter().enumerate() {
                 prop_assert!((v[ch] - want).abs() <= 1e-6 * want, "constant {}: {:?}", want, v);
             }

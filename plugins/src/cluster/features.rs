@@ -265,7 +265,7 @@ impl FeatureScale {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film::Spectrum;
+    use crate::color::Spectrum;
     use crate::space::{Dims, RenderingSpace};
 
     fn grid(w: u32, h: u32) -> CellGrid {

@@ -2,7 +2,8 @@
 //! Image dims are cut every `cellsize` pixels, each non-image dim into `bins` intervals; the
 //! non-image dims are innermost in the cell index, so a pixel's cells lie together in memory.
 
-use crate::film::{luminance, Spectrum};
+use crate::color::{luminance, Spectrum};
+use crate::first_hit::Features;
 use crate::space::{in_pixel, RenderingSpace, SamplePoint};
 use rayon::prelude::*;
 
@@ -380,14 +381,21 @@ struct Band<'a> {
     lum_sq: &'a mut [f64],
     offset: &'a mut [f32],
     offset_sq: &'a mut [f32],
+    features: &'a mut [Features],
     dims: usize,
 }
 
 impl Band<'_> {
-    /// Adds one sample of radiance `l` at offsets `off` to cell `i` of the band.
+    /// Adds one sample of radiance `l` at offsets `off`, with first-hit features `f`, to cell
+    /// `i` of the band (the features only when the sums keep them).
     #[inline]
-    fn add(&mut self, i: usize, off: &[f32; MAX_DIMS], l: Spectrum) {
+    fn add(&mut self, i: usize, off: &[f32; MAX_DIMS], l: Spectrum, f: Option<&Features>) {
         self.count[i] += 1;
+        if let (Some(sum), Some(f)) = (self.features.get_mut(i), f) {
+            for (s, v) in sum.iter_mut().zip(f) {
+                *s += v;
+            }
+        }
         let y = f64::from(luminance(l));
         self.lum[i] += y;
         self.lum_sq[i] += y * y;
@@ -429,6 +437,8 @@ pub struct CellSums {
     /// Sum of the squared offsets, `dims` per cell: with `offset`, the mean of any quadratic
     /// over the cell's samples (the polynomial fit's rows).
     pub offset_sq: Vec<f32>,
+    /// Sum of the samples' first-hit features; empty unless made [`CellSums::with_features`].
+    pub features: Vec<Features>,
     dims: usize,
 }
 
@@ -459,8 +469,27 @@ impl CellSums {
             lum_sq: vec![0.0; n],
             offset: Vec::new(),
             offset_sq: Vec::new(),
+            features: Vec::new(),
             dims: grid.dims(),
         }
+    }
+
+    /// These sums, also keeping each cell's sum of first-hit features.
+    pub fn with_features(mut self) -> Self {
+        self.features = vec![[0.0; crate::first_hit::FEATURES]; self.count.len()];
+        self
+    }
+
+    /// Whether the sums keep first-hit features.
+    pub fn keeps_features(&self) -> bool {
+        !self.features.is_empty()
+    }
+
+    /// The mean first-hit features of cell `i`; None without samples or without features.
+    pub fn mean_features(&self, i: usize) -> Option<[f64; crate::first_hit::FEATURES]> {
+        let n = *self.count.get(i)?;
+        let f = self.features.get(i)?;
+        (n > 0).then(|| f.map(|v| f64::from(v) / f64::from(n)))
     }
 
     /// Whether the sums hold radiance and positions, not only luminance.
@@ -471,14 +500,20 @@ impl CellSums {
     /// Adds one sample of radiance `l` at offsets `off` to cell `i`.
     #[inline]
     pub fn add(&mut self, i: usize, off: &[f32; MAX_DIMS], l: Spectrum) {
-        self.band(0, self.count.len()).add(i, off, l);
+        self.band(0, self.count.len()).add(i, off, l, None);
     }
 
     /// Adds a batch of samples: the sample in cell `located[k].0` at offsets `located[k].1`
-    /// with radiance `radiance[k]`, skipping radiance that is not finite (a dropped sample).
-    /// Bands of cells are summed in parallel, each cell's samples in batch order, so the sums
-    /// do not depend on the thread count.
-    pub fn add_batch(&mut self, located: &[(u32, [f32; MAX_DIMS])], radiance: &[[f32; 3]]) {
+    /// with radiance `radiance[k]` (and first-hit features `features[k]`, when given and
+    /// kept), skipping radiance that is not finite (a dropped sample). Bands of cells are
+    /// summed in parallel, each cell's samples in batch order, so the sums do not depend on
+    /// the thread count.
+    pub fn add_batch(
+        &mut self,
+        located: &[(u32, [f32; MAX_DIMS])],
+        radiance: &[[f32; 3]],
+        features: Option<&[Features]>,
+    ) {
         let cells = self.count.len();
         let bands = if located.len() < PARALLEL_BATCH {
             1
@@ -497,7 +532,8 @@ impl CellSums {
             for &k in members {
                 let (cell, off) = &located[k as usize];
                 let i = *cell as usize - b * band_len;
-                band.add(i, off, Spectrum::from_array(radiance[k as usize]));
+                let f = features.and_then(|f| f.get(k as usize));
+                band.add(i, off, Spectrum::from_array(radiance[k as usize]), f);
             }
         };
         if bands == 1 {
@@ -520,6 +556,11 @@ impl CellSums {
         } else {
             (start..end, start * d..end * d)
         };
+        let f = if self.features.is_empty() {
+            0..0
+        } else {
+            start..end
+        };
         Band {
             count: &mut self.count[start..end],
             rgb: &mut self.rgb[r.clone()],
@@ -528,6 +569,7 @@ impl CellSums {
             lum_sq: &mut self.lum_sq[start..end],
             offset: &mut self.offset[o.clone()],
             offset_sq: &mut self.offset_sq[o],
+            features: &mut self.features[f],
             dims: d,
         }
     }
@@ -548,8 +590,9 @@ impl CellSums {
             .zip(self.lum_sq.chunks_mut(band_len))
             .zip(chunks(&mut self.offset, band_len * d))
             .zip(chunks(&mut self.offset_sq, band_len * d))
+            .zip(chunks(&mut self.features, band_len))
             .map(
-                |((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq)| Band {
+                |(((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq), features)| Band {
                     count,
                     rgb,
                     rgb_sq,
@@ -557,6 +600,7 @@ impl CellSums {
                     lum_sq,
                     offset,
                     offset_sq,
+                    features,
                     dims: d,
                 },
             )
@@ -589,6 +633,7 @@ impl CellSums {
             + self.lum_sq.capacity() * 8
             + self.offset.capacity() * 4
             + self.offset_sq.capacity() * 4
+            + self.features.capacity() * std::mem::size_of::<Features>()
     }
 
     /// Active dims (offsets per cell).
@@ -736,8 +781,8 @@ mod tests {
             })
             .collect();
         let (mut full, mut lum) = (CellSums::new(&g), CellSums::luminance_only(&g));
-        full.add_batch(&located, &radiance);
-        lum.add_batch(&located, &radiance);
+        full.add_batch(&located, &radiance, None);
+        lum.add_batch(&located, &radiance, None);
         assert!(full.keeps_radiance() && !lum.keeps_radiance());
         assert_eq!(full.count, lum.count);
         assert_eq!(full.lum, lum.lum);

@@ -16,18 +16,12 @@ pub use sinc::LanczosSincFilter;
 pub use triangle::TriangleFilter;
 
 use crate::cluster::CellView;
-use crate::film::{Film, Spectrum};
+use crate::color::Spectrum;
+use crate::film::Film;
+pub use crate::kernel::FilterKernel;
 use crate::partition::Partition;
 use crate::registry::{Choice, Entry};
 use acr_parser::{Error, ParamList, Result};
-
-/// A separable or non-separable 2D filter of finite support.
-pub trait FilterKernel: Send + Sync {
-    /// Half-widths in x and y (pixels).
-    fn radius(&self) -> (f32, f32);
-    /// The weight at offset (x, y) from the pixel centre; zero outside the radius.
-    fn eval(&self, x: f32, y: f32) -> f32;
-}
 
 /// A reconstruction filter: turns the film into the image.
 pub trait Filter: Send + Sync {
@@ -46,6 +40,19 @@ pub trait Filter: Send + Sync {
     /// filter when the sampler keeps none; None for a filter that needs no cells.
     fn cell_layout(&self) -> Option<(f64, u32)> {
         None
+    }
+
+    /// The clusters the last reconstruction fitted, per pixel of the cropped film (the
+    /// cluster of the cell under each pixel's centre); None for a filter that fits none.
+    fn fit_partition(&self) -> Option<Partition> {
+        None
+    }
+
+    /// Whether the filter reads the samples' first-hit features from the film's cells, in a
+    /// rendering space of `dims` dims: the film then collects cells with them, whatever the
+    /// sampler keeps.
+    fn reads_features(&self, _dims: usize) -> bool {
+        false
     }
 
     /// What the last reconstruction reports for the stats file (nothing, for a splatting

@@ -5,6 +5,11 @@
 //! cluster sampler it uses that sampler's cells and clusters; after any other sampler the film
 //! collects cells (1 pixel, no cut of the time and lens dims) and the clusters are grown from
 //! them with the sampler's code and default knobs.
+//!
+//! With `features` on, the film keeps first-hit features in its own cells (one per pixel)
+//! whatever the sampler, the fit's clusters are merged by noise where the features agree too
+//! (`cluster/by_noise.rs`), and each cluster's model has a linear term per feature
+//! (`regression.rs`).
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
 use crate::cluster::build::{initial_clustering, Initial};
@@ -12,10 +17,11 @@ use crate::cluster::by_noise::{grow_by_noise, NoiseClusters};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
+use crate::partition::Partition;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
 use crate::sampler::ClusterSettings;
-use acr_parser::{ParamType, Result};
+use acr_parser::{Error, ParamType, Result};
 use rayon::prelude::*;
 use std::sync::Mutex;
 
@@ -33,12 +39,48 @@ pub struct PolynomialFilter {
     kernel: BoxFilter,
     /// Clusters fitted at each degree by the last reconstruction.
     fitted: Mutex<[u64; MAX_DEGREE as usize + 1]>,
+    /// The clusters of the last reconstruction, per pixel.
+    partition: Mutex<Option<Partition>>,
     /// The fit's own clustering (ω, most cells), grown from the cells even where the sampler
     /// gives one; None: the sampler's clusters, or the sampler's defaults.
     own: Option<(f64, u32)>,
     /// With z > 0: the fit's clusters merged by noise at z standard errors (`by_noise.rs`).
     noise_z: f64,
+    /// With Some(tolerance): regress on first-hit features, in clusters whose features agree
+    /// within the tolerance. Set by the registry; [`FeatureChoice`] says when.
+    features: Option<f64>,
+    /// Whether features are on: always, never, or above x and y only (the default).
+    feature_choice: FeatureChoice,
+    /// How a cell weighs in its cluster's fit.
+    weights: CellWeights,
 }
+
+/// When the fit regresses on first-hit features.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FeatureChoice {
+    /// Always.
+    On,
+    /// Never (the paper's method).
+    Off,
+    /// When the rendering space has time or lens dims: measured better there (motion blur,
+    /// defocus), worse on the 2D Cornell box, where the sampler's clusters fit best.
+    AboveImage,
+}
+
+/// How a cell weighs in its cluster's least squares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellWeights {
+    /// Its sample count (the paper's): an adaptive sampler chose it from the same values.
+    Count,
+    /// Every sampled cell alike: the weight does not depend on the values.
+    Uniform,
+}
+
+/// Standard errors of the noise test when features are on and `noise` is not set.
+pub const FEATURE_NOISE_Z: f64 = 8.0;
+
+/// The features' tolerance when features are on and `featuretolerance` is not set.
+pub const FEATURE_TOLERANCE: f64 = 0.1;
 
 impl PolynomialFilter {
     /// The filter with its knobs.
@@ -50,8 +92,35 @@ impl PolynomialFilter {
             significance,
             kernel: BoxFilter::new(0.5, 0.5),
             fitted: Mutex::new([0; MAX_DEGREE as usize + 1]),
+            partition: Mutex::new(None),
             own: None,
             noise_z: 0.0,
+            features: None,
+            feature_choice: FeatureChoice::Off,
+            weights: CellWeights::Count,
+        }
+    }
+
+    /// Weighs cells in the fit by `weights`.
+    pub fn with_weights(mut self, weights: CellWeights) -> Self {
+        self.weights = weights;
+        self
+    }
+
+    /// Regresses on first-hit features (as `choice` says) in clusters whose features agree
+    /// within `tolerance`.
+    pub fn with_features(mut self, choice: FeatureChoice, tolerance: f64) -> Self {
+        self.feature_choice = choice;
+        self.features = Some(tolerance);
+        self
+    }
+
+    /// The features' tolerance when they are on for a space of `dims` dims.
+    fn features_for(&self, dims: usize) -> Option<f64> {
+        match self.feature_choice {
+            FeatureChoice::On => self.features,
+            FeatureChoice::Off => None,
+            FeatureChoice::AboveImage => self.features.filter(|_| dims > 2),
         }
     }
 
@@ -76,11 +145,16 @@ impl PolynomialFilter {
     /// The image from `view`'s cells, clustered as given or as grown here.
     fn reconstruct_cells(&self, film: &Film, view: CellView<'_>) -> Vec<Spectrum> {
         let (grid, sums) = (view.grid, view.sums);
+        let features = self.features_for(grid.dims());
         let grown: Option<Initial>;
         let by_noise: NoiseClusters;
         let (cluster_cells, of_cell): (Vec<&[u32]>, &[u32]) = match (view.clustering, self.own) {
-            _ if self.noise_z > 0.0 => {
-                by_noise = grow_by_noise(grid, sums, self.noise_z);
+            _ if features.is_some() || self.noise_z > 0.0 => {
+                let z = match self.noise_z {
+                    z if z > 0.0 => z,
+                    _ => FEATURE_NOISE_Z,
+                };
+                by_noise = grow_by_noise(grid, sums, z, features);
                 (
                     by_noise.clusters.iter().map(Vec::as_slice).collect(),
                     &by_noise.of_cell,
@@ -112,6 +186,7 @@ impl PolynomialFilter {
                 .min(MAX_DEGREE),
             ridge: self.ridge,
             clamp: self.clamp,
+            features: features.is_some() && sums.keeps_features(),
         };
         // Each cluster's model, and the per-sample noise variance of its cells.
         let (fits, noise): (Vec<Fit>, Vec<[f64; 3]>) = cluster_cells
@@ -119,12 +194,12 @@ impl PolynomialFilter {
             .map(|c| {
                 let cells: Vec<FitCell> = c
                     .iter()
-                    .map(|&i| fit_cell(grid, sums, i as usize))
+                    .map(|&i| fit_cell(grid, sums, i as usize, self.weights))
                     .collect();
                 let fit = Fit::new(&cells, n, &settings);
                 let noise = pooled_noise(sums, c);
                 (
-                    refit(fit, cells, &noise, n, &settings, self.significance),
+                    refit(fit, cells, sums, c, &noise, n, &settings, self.significance),
                     noise,
                 )
             })
@@ -137,6 +212,20 @@ impl PolynomialFilter {
         }
         *self.fitted.lock().unwrap_or_else(|e| e.into_inner()) = fitted;
         let (w, h) = film.settings().size();
+        let partition = Partition {
+            width: w,
+            height: h,
+            cluster: (0..h)
+                .flat_map(|py| (0..w).map(move |px| (px, py)))
+                .map(|(px, py)| {
+                    let (cx, cy) = grid.image_cell_of_pixel(px, py);
+                    let first = (cy as usize * grid.shape()[0] as usize + cx as usize)
+                        * grid.cells_per_image_cell();
+                    of_cell[first]
+                })
+                .collect(),
+        };
+        *self.partition.lock().unwrap_or_else(|e| e.into_inner()) = Some(partition);
         let stats = film.pixel_stats();
         (0..h)
             .into_par_iter()
@@ -161,8 +250,8 @@ impl PolynomialFilter {
     }
 }
 
-/// The fit's view of cell `i`.
-fn fit_cell(grid: &CellGrid, sums: &CellSums, i: usize) -> FitCell {
+/// The fit's view of cell `i`, weighted by `weights`.
+fn fit_cell(grid: &CellGrid, sums: &CellSums, i: usize, weights: CellWeights) -> FitCell {
     let (lo, hi) = grid.bounds(i);
     let n = sums.count[i];
     let dims = sums.dims();
@@ -172,7 +261,11 @@ fn fit_cell(grid: &CellGrid, sums: &CellSums, i: usize) -> FitCell {
         m1: [0.5; MAX_DIMS],
         m2: [1.0 / 3.0; MAX_DIMS],
         mean: [0.0; 3],
-        weight: f64::from(n),
+        features: sums.mean_features(i).unwrap_or_default(),
+        weight: match weights {
+            CellWeights::Count => f64::from(n),
+            CellWeights::Uniform => f64::from(u8::from(n > 0)),
+        },
     };
     if n > 0 {
         let inv = 1.0 / f64::from(n);
@@ -212,9 +305,12 @@ fn pooled_noise(sums: &CellSums, cells: &[u32]) -> [f64; 3] {
 /// standard errors in any channel, when they are fewer than half of the sampled cells: a
 /// cluster that holds cells on both sides of an edge is then fitted to its majority side, and
 /// the others keep their own means (see `Model::pixel`).
+#[allow(clippy::too_many_arguments)]
 fn refit(
     fit: Fit,
     mut cells: Vec<FitCell>,
+    sums: &CellSums,
+    ids: &[u32],
     noise: &[f64; 3],
     dims: usize,
     settings: &FitSettings,
@@ -225,10 +321,11 @@ fn refit(
     }
     let sampled = cells.iter().filter(|c| c.weight > 0.0).count();
     let mut outliers = 0;
-    for c in cells.iter_mut().filter(|c| c.weight > 0.0) {
-        let v = fit.mean_over(&c.lo, &c.hi);
+    for (c, &i) in cells.iter_mut().zip(ids).filter(|(c, _)| c.weight > 0.0) {
+        let v = fit.mean_over(&c.lo, &c.hi, Some(&c.features));
+        let count = f64::from(sums.count[i as usize]);
         let far = (0..3).any(|ch| {
-            let se = (noise[ch] / c.weight).sqrt();
+            let se = (noise[ch] / count).sqrt();
             (c.mean[ch] - v[ch]).abs() > significance * se
         });
         if far {
@@ -293,10 +390,11 @@ impl Model<'_> {
                     if volume <= 0.0 {
                         continue;
                     }
-                    let mut v = fit.mean_over(&lo, &hi);
+                    let features = self.sums.mean_features(i);
+                    let mut v = fit.mean_over(&lo, &hi, features.as_ref());
                     let count = self.sums.count[i];
                     if self.significance > 0.0 && count > 0 {
-                        let whole = fit.mean_over(&cell_lo, &cell_hi);
+                        let whole = fit.mean_over(&cell_lo, &cell_hi, features.as_ref());
                         let n = f64::from(count);
                         for ch in 0..3 {
                             let mean = f64::from(self.sums.rgb[i][ch]) / n;
@@ -334,7 +432,16 @@ impl Filter for PolynomialFilter {
     }
 
     fn reconstruct(&self, film: &Film, from: SamplerOutput<'_>) -> Vec<Spectrum> {
-        match from.cells.or_else(|| film.cells()) {
+        // With features, the film's cells: they hold them, whatever the sampler keeps.
+        let film_first = film
+            .cells()
+            .is_some_and(|v| self.features_for(v.grid.dims()).is_some());
+        let cells = if film_first {
+            film.cells()
+        } else {
+            from.cells.or_else(|| film.cells())
+        };
+        match cells {
             Some(view) => self.reconstruct_cells(film, view),
             // No cells anywhere (a film made without them): the pixel means.
             None => film.pixels(),
@@ -350,6 +457,17 @@ impl Filter for PolynomialFilter {
     fn cell_layout(&self) -> Option<(f64, u32)> {
         // The cluster sampler's default cells: one per pixel, time and lens not cut.
         Some((1.0, 1))
+    }
+
+    fn fit_partition(&self) -> Option<Partition> {
+        self.partition
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }
+
+    fn reads_features(&self, dims: usize) -> bool {
+        self.features_for(dims).is_some()
     }
 }
 
@@ -400,6 +518,27 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
                  many standard errors of their pooled noise",
             ),
             ParamSpec::new(
+                "features",
+                ParamType::Bool,
+                "true with time or lens dims, false on x, y only",
+                "regress on the first-hit features (albedo, normal, depth) too, in clusters \
+                 merged by noise where the features agree (noise 8 unless set)",
+            ),
+            ParamSpec::new(
+                "featuretolerance",
+                ParamType::Float,
+                "0.1",
+                "with features: the most two clusters' mean features may differ to merge \
+                 (albedo per channel, half the normal per axis, depth relative)",
+            ),
+            ParamSpec::new(
+                "weights",
+                ParamType::String,
+                "count",
+                "a cell's weight in its cluster's fit: \"count\" (its samples, the paper's) \
+                 or \"uniform\" (every sampled cell alike, independent of the values)",
+            ),
+            ParamSpec::new(
                 "clamp",
                 ParamType::Bool,
                 "true",
@@ -421,6 +560,24 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     let significance = float_in(p, "significance", 3.0, 0.0..=1e3)?;
     let mut f = PolynomialFilter::new(degree, ridge, clamp, significance)
         .with_noise_clusters(float_in(p, "noise", 0.0, 0.0..=1e3)?);
+    let tolerance = float_in(p, "featuretolerance", FEATURE_TOLERANCE, 0.0..=1e3)?;
+    let choice = match p.get("features") {
+        None => FeatureChoice::AboveImage,
+        Some(_) if p.bool_or("features", true)? => FeatureChoice::On,
+        Some(_) => FeatureChoice::Off,
+    };
+    f = f.with_features(choice, tolerance);
+    f = f.with_weights(match p.string("weights")? {
+        None | Some("count") => CellWeights::Count,
+        Some("uniform") => CellWeights::Uniform,
+        Some(other) => {
+            let loc = &p.get("weights").expect("given").loc;
+            return Err(Error::at(
+                loc,
+                format!("weights \"{other}\" is not known (count or uniform)"),
+            ));
+        }
+    });
     if p.get("omega").is_some() || p.get("maxclustercells").is_some() {
         let d = ClusterSettings::new(1);
         let omega = float_in(p, "omega", d.omega, 1e-3..=1e3)?;

@@ -790,11 +790,11 @@ impl Sampler for ClusterSampler {
         };
         let Some((cells, clusters)) = round else {
             self.grid.locate_all(batch, &mut self.round_cells);
-            self.sums.add_batch(&self.round_cells, radiance);
+            self.sums.add_batch(&self.round_cells, radiance, None);
             return;
         };
         // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
-        self.sums.add_batch(&cells, radiance);
+        self.sums.add_batch(&cells, radiance, None);
         for (&(cell, _), l) in cells.iter().zip(radiance) {
             if !l[0].is_nan() {
                 self.touched[cell as usize / 64] |= 1 << (cell % 64);
