@@ -60,7 +60,7 @@ impl Plugins {
     pub fn film(&self, scene: &crate::scene::Scene) -> Film {
         let mut film = Film::new(scene.film.clone(), self.filter.kernel());
         if let Some((cell_size, bins)) = self.filter.cell_layout() {
-            let features = self.filter.reads_features(scene.dims.count());
+            let features = self.filter.reads_features();
             if !self.sampler.keeps_cells() || features {
                 let space = crate::render::rendering_space(scene);
                 film.collect_cells(CellGrid::new(space, cell_size, bins), features);

@@ -46,9 +46,18 @@ fn space() -> RenderingSpace {
     RenderingSpace::whole(W, H, Dims::default())
 }
 
+/// Filter `name` with its defaults; `polynomial` without first-hit features (the paper's fit:
+/// the field here has none; `feature_regression.rs` tests them).
 fn filter(name: &str) -> Box<dyn Filter> {
     let e = FILTERS.iter().find(|e| e.info.name == name).unwrap();
-    (e.build)(&Choice::new(None, name, None)).unwrap()
+    let mut c = Choice::new(None, name, None);
+    if name == "polynomial" {
+        Setting::parse("filter.features=false")
+            .unwrap()
+            .apply(&e.info, &mut c)
+            .unwrap();
+    }
+    (e.build)(&c).unwrap()
 }
 
 /// The image `f` makes from the samples of `s` on the field.
@@ -163,7 +172,11 @@ fn the_filter_grows_its_own_clusters_when_given_omega() {
         .find(|e| e.info.name == "polynomial")
         .unwrap();
     let mut c = Choice::new(None, "polynomial", None);
-    for arg in ["filter.omega=0.1", "filter.maxclustercells=256"] {
+    for arg in [
+        "filter.omega=0.1",
+        "filter.maxclustercells=256",
+        "filter.features=false",
+    ] {
         Setting::parse(arg).unwrap().apply(&e.info, &mut c).unwrap();
     }
     let own = (e.build)(&c).unwrap();

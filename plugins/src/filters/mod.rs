@@ -48,10 +48,9 @@ pub trait Filter: Send + Sync {
         None
     }
 
-    /// Whether the filter reads the samples' first-hit features from the film's cells, in a
-    /// rendering space of `dims` dims: the film then collects cells with them, whatever the
-    /// sampler keeps.
-    fn reads_features(&self, _dims: usize) -> bool {
+    /// Whether the filter reads the samples' first-hit features from the film's cells: the
+    /// film then collects cells with them, whatever the sampler keeps.
+    fn reads_features(&self) -> bool {
         false
     }
 

@@ -47,24 +47,10 @@ pub struct PolynomialFilter {
     /// With z > 0: the fit's clusters merged by noise at z standard errors (`by_noise.rs`).
     noise_z: f64,
     /// With Some(tolerance): regress on first-hit features, in clusters whose features agree
-    /// within the tolerance. Set by the registry; [`FeatureChoice`] says when.
+    /// within the tolerance.
     features: Option<f64>,
-    /// Whether features are on: always, never, or above x and y only (the default).
-    feature_choice: FeatureChoice,
     /// How a cell weighs in its cluster's fit.
     weights: CellWeights,
-}
-
-/// When the fit regresses on first-hit features.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FeatureChoice {
-    /// Always.
-    On,
-    /// Never (the paper's method).
-    Off,
-    /// When the rendering space has time or lens dims: measured better there (motion blur,
-    /// defocus), worse on the 2D Cornell box, where the sampler's clusters fit best.
-    AboveImage,
 }
 
 /// How a cell weighs in its cluster's least squares.
@@ -96,7 +82,6 @@ impl PolynomialFilter {
             own: None,
             noise_z: 0.0,
             features: None,
-            feature_choice: FeatureChoice::Off,
             weights: CellWeights::Count,
         }
     }
@@ -107,21 +92,11 @@ impl PolynomialFilter {
         self
     }
 
-    /// Regresses on first-hit features (as `choice` says) in clusters whose features agree
-    /// within `tolerance`.
-    pub fn with_features(mut self, choice: FeatureChoice, tolerance: f64) -> Self {
-        self.feature_choice = choice;
-        self.features = Some(tolerance);
+    /// Regresses on first-hit features in clusters whose features agree within `tolerance`
+    /// (None: off, the paper's method).
+    pub fn with_features(mut self, tolerance: Option<f64>) -> Self {
+        self.features = tolerance;
         self
-    }
-
-    /// The features' tolerance when they are on for a space of `dims` dims.
-    fn features_for(&self, dims: usize) -> Option<f64> {
-        match self.feature_choice {
-            FeatureChoice::On => self.features,
-            FeatureChoice::Off => None,
-            FeatureChoice::AboveImage => self.features.filter(|_| dims > 2),
-        }
     }
 
     /// Fits clusters merged by noise at `z` standard errors (0: off).
@@ -145,7 +120,7 @@ impl PolynomialFilter {
     /// The image from `view`'s cells, clustered as given or as grown here.
     fn reconstruct_cells(&self, film: &Film, view: CellView<'_>) -> Vec<Spectrum> {
         let (grid, sums) = (view.grid, view.sums);
-        let features = self.features_for(grid.dims());
+        let features = self.features;
         let grown: Option<Initial>;
         let by_noise: NoiseClusters;
         let (cluster_cells, of_cell): (Vec<&[u32]>, &[u32]) = match (view.clustering, self.own) {
@@ -433,9 +408,7 @@ impl Filter for PolynomialFilter {
 
     fn reconstruct(&self, film: &Film, from: SamplerOutput<'_>) -> Vec<Spectrum> {
         // With features, the film's cells: they hold them, whatever the sampler keeps.
-        let film_first = film
-            .cells()
-            .is_some_and(|v| self.features_for(v.grid.dims()).is_some());
+        let film_first = self.features.is_some() && film.cells().is_some();
         let cells = if film_first {
             film.cells()
         } else {
@@ -466,8 +439,8 @@ impl Filter for PolynomialFilter {
             .clone()
     }
 
-    fn reads_features(&self, dims: usize) -> bool {
-        self.features_for(dims).is_some()
+    fn reads_features(&self) -> bool {
+        self.features.is_some()
     }
 }
 
@@ -520,7 +493,7 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
             ParamSpec::new(
                 "features",
                 ParamType::Bool,
-                "true with time or lens dims, false on x, y only",
+                "true",
                 "regress on the first-hit features (albedo, normal, depth) too, in clusters \
                  merged by noise where the features agree (noise 8 unless set)",
             ),
@@ -561,12 +534,9 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     let mut f = PolynomialFilter::new(degree, ridge, clamp, significance)
         .with_noise_clusters(float_in(p, "noise", 0.0, 0.0..=1e3)?);
     let tolerance = float_in(p, "featuretolerance", FEATURE_TOLERANCE, 0.0..=1e3)?;
-    let choice = match p.get("features") {
-        None => FeatureChoice::AboveImage,
-        Some(_) if p.bool_or("features", true)? => FeatureChoice::On,
-        Some(_) => FeatureChoice::Off,
-    };
-    f = f.with_features(choice, tolerance);
+    if p.bool_or("features", true)? {
+        f = f.with_features(Some(tolerance));
+    }
     f = f.with_weights(match p.string("weights")? {
         None | Some("count") => CellWeights::Count,
         Some("uniform") => CellWeights::Uniform,
