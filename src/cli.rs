@@ -5,7 +5,7 @@ use crate::features::FeatureImage;
 use crate::image_io::{write_image, RgbImage};
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
-use crate::render::{render, render_with_features, MAX_SPP};
+use crate::render::{render, render_with_features, Halt, Stop, MAX_SPP};
 use crate::replay::{Recording, Replay};
 use crate::scene::Scene;
 use crate::stats::{median, peak_rss_mb, Seconds, Stats};
@@ -35,7 +35,7 @@ pub enum Command {
         scene: PathBuf,
     },
     /// Render a scene to an image (.exr, .png or .pfm).
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// List every plugin (samplers, filters, integrators) with its parameters and defaults.
     Plugins,
     /// Time against error: render a manifest's scenes with its methods at its budgets, and
@@ -75,6 +75,15 @@ pub struct RenderArgs {
     /// pixel keeps as many samples as the others); --spp or the scene's budget still caps it.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
+    /// Stop once the image's estimated relative error (the mean over pixels of the standard
+    /// error of the pixel's luminance over its mean + 0.01) is below T, at the end of the pass
+    /// under way; --spp or the scene's budget still caps it. Any sampler.
+    #[arg(long, value_name = "T", value_parser = parse_threshold)]
+    pub noise_threshold: Option<f64>,
+    /// Samples per pixel before --noise-threshold may stop the render (at least 2).
+    #[arg(long, value_name = "N", default_value_t = 4, requires = "noise_threshold",
+          value_parser = clap::value_parser!(u32).range(2..=MAX_SPP as i64))]
+    pub min_spp: u32,
     /// The sampler, by name (overrides the scene's Sampler; see `acr plugins`).
     #[arg(long)]
     pub sampler: Option<String>,
@@ -107,7 +116,7 @@ pub struct RenderArgs {
     /// batches are traced again by a sampler that only replays them, alternating with renders
     /// by a fresh sampler (same image, checked; three of each), and the stats give the median
     /// times and the sampler's share. Holds every point in memory (32 bytes each).
-    #[arg(long, conflicts_with = "time_limit")]
+    #[arg(long, conflicts_with_all = ["time_limit", "noise_threshold"])]
     pub sampler_cost: bool,
     /// No progress bar and no summary line.
     #[arg(long, short = 'q')]
@@ -337,7 +346,11 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     } else {
         recording.inner()
     };
-    let time_limit = args.time_limit.map(std::time::Duration::from_secs_f64);
+    let stop = Stop {
+        time_limit: args.time_limit.map(std::time::Duration::from_secs_f64),
+        noise_threshold: args.noise_threshold,
+        min_spp: args.min_spp,
+    };
     let mut features = aovs.iter().any(AovRequest::is_feature).then(|| {
         let [x0, x1, y0, y1] = scene.film.crop;
         FeatureImage::new(x0, x1, y0, y1)
@@ -348,7 +361,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         sampler,
         &mut film,
         args.seed,
-        time_limit,
+        &stop,
         bar.as_ref(),
         features.as_mut(),
     );
@@ -418,6 +431,7 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         filter: plugins.reconstruction().into(),
         integrator: plugins.integrator.name().into(),
         halted: counts.halted,
+        halted_by: counts.halted_by.map(Halt::name),
         dims: scene.dims.names().into_iter().map(str::to_owned).collect(),
         clusters: report.clusters,
         cells: report.cells,
@@ -455,8 +469,12 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
         );
     }
     if counts.halted && !args.quiet {
+        let why = match counts.halted_by {
+            Some(Halt::Noise) => "noise threshold",
+            _ => "time limit",
+        };
         eprintln!(
-            "time limit: stopped after {} of {} samples per pixel",
+            "{why}: stopped after {} of {} samples per pixel",
             counts.samples / (u64::from(w) * u64::from(h)).max(1),
             spp
         );
@@ -515,6 +533,13 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 && v < 1e9 => Ok(v),
         _ => Err(format!("\"{s}\" is not a positive number of seconds")),
+    }
+}
+
+fn parse_threshold(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("\"{s}\" is not a positive relative error")),
     }
 }
 

@@ -38,6 +38,70 @@ pub fn in_pixel(px: u32, py: u32, u: Vec2) -> Vec2 {
     p.min(Vec2::new(below(px + 1), below(py + 1)))
 }
 
+/// When a render stops before its sampler's budget is spent.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stop {
+    /// Stop once this much render time has passed (at the end of the pass under way).
+    pub time_limit: Option<Duration>,
+    /// Stop once the image's estimated relative error ([`relative_error`]) is below this (at
+    /// the end of the pass under way).
+    pub noise_threshold: Option<f64>,
+    /// Samples per pixel before the noise threshold is looked at (at least 2: the error
+    /// estimate needs a variance).
+    pub min_spp: u32,
+}
+
+impl Stop {
+    /// A time limit alone.
+    pub fn time(limit: Option<Duration>) -> Self {
+        Self {
+            time_limit: limit,
+            ..Self::default()
+        }
+    }
+}
+
+/// Why a render stopped before its budget was spent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Halt {
+    /// The time limit passed.
+    Time,
+    /// The image's estimated relative error fell below the noise threshold.
+    Noise,
+}
+
+impl Halt {
+    /// The name the stats file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Halt::Time => "time",
+            Halt::Noise => "noise",
+        }
+    }
+}
+
+/// The image's estimated relative error: the mean over pixels of the standard error of the
+/// pixel's mean luminance over (that mean + 0.01), Cycles' and LuxCore's kind of measure. The
+/// 0.01 keeps black pixels from dominating. Pixels with fewer than 2 samples count as 1 (no
+/// estimate yet).
+pub fn relative_error(stats: &[acr_plugins::PixelStats]) -> f64 {
+    if stats.is_empty() {
+        return 0.0;
+    }
+    let sum: f64 = stats
+        .iter()
+        .map(|s| {
+            if s.count < 2 {
+                return 1.0;
+            }
+            let mean = f64::from(crate::spectrum_luminance(s.mean())).max(0.0);
+            let var = f64::from(crate::spectrum_luminance(s.variance_of_mean())).max(0.0);
+            var.sqrt() / (mean + 0.01)
+        })
+        .sum();
+    sum / stats.len() as f64
+}
+
 /// What a render produced besides the image.
 #[derive(Clone, Debug, Default)]
 pub struct RenderCounts {
@@ -47,8 +111,11 @@ pub struct RenderCounts {
     pub rays: u64,
     /// Samples whose radiance was NaN, infinite or negative, dropped before the film.
     pub dropped: u64,
-    /// The time limit stopped the render before the sampler's budget was spent.
+    /// The time limit or the noise threshold stopped the render before the sampler's budget
+    /// was spent.
     pub halted: bool,
+    /// Which of them did.
+    pub halted_by: Option<Halt>,
     /// Wall seconds spent in the sampler (its batches and what it learns from them).
     pub sampler_seconds: f64,
     /// Samples whose first-hit features were not finite (set to 0 for the film's cells).
@@ -66,12 +133,14 @@ pub fn render(
     time_limit: Option<Duration>,
     progress: Option<&indicatif::ProgressBar>,
 ) -> RenderCounts {
+    let stop = Stop::time(time_limit);
     render_with_features(
-        scene, integrator, sampler, film, seed, time_limit, progress, None,
+        scene, integrator, sampler, film, seed, &stop, progress, None,
     )
 }
 
-/// [`render`], also adding each sample's first-hit features to `features` when given.
+/// [`render`] with any [`Stop`] rule, also adding each sample's first-hit features to
+/// `features` when given.
 #[allow(clippy::too_many_arguments)]
 pub fn render_with_features(
     scene: &Scene,
@@ -79,14 +148,12 @@ pub fn render_with_features(
     sampler: &mut dyn Sampler,
     film: &mut Film,
     seed: u64,
-    time_limit: Option<Duration>,
+    stop: &Stop,
     progress: Option<&indicatif::ProgressBar>,
     features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
     let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
-    render_with(
-        scene, &li, sampler, film, seed, time_limit, progress, features,
-    )
+    render_with(scene, &li, sampler, film, seed, stop, progress, features)
 }
 
 /// A traced batch and what became of its samples, waiting for the sampler and the film.
@@ -161,7 +228,7 @@ type SampleResult = (Spectrum, u32, FirstHit);
 /// [`render`] with any estimator in place of an integrator (tests give it one that misbehaves).
 /// Radiance that is NaN, infinite or negative is dropped and counted where it arises; the rest
 /// is clamped by the film's limits before the sampler, the cells and the film see it. With
-/// `features`, each sample's first-hit features are added there.
+/// `features`, each sample's first-hit features are added there. `stop` may end it early.
 #[allow(clippy::too_many_arguments)]
 pub fn render_with(
     scene: &Scene,
@@ -169,7 +236,7 @@ pub fn render_with(
     sampler: &mut dyn Sampler,
     film: &mut Film,
     seed: u64,
-    time_limit: Option<Duration>,
+    stop: &Stop,
     progress: Option<&indicatif::ProgressBar>,
     mut features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
@@ -204,6 +271,10 @@ pub fn render_with(
     let mut traced = Traced::default();
     let mut pending = false;
     let mut in_sampler = Duration::ZERO;
+    // The noise threshold is looked at once per sample per pixel given (it reads every pixel),
+    // from `min_spp` on.
+    let pixels = space.pixels().max(1);
+    let mut next_check = pixels * u64::from(stop.min_spp.max(2));
     let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
     while more {
         // While `batch` is traced, the sampler and the film take the batch before and, when
@@ -224,8 +295,19 @@ pub fn render_with(
         if let Some(p) = progress {
             p.set_position(counts.samples);
         }
-        if time_limit.is_some_and(|t| start.elapsed() >= t) {
-            sampler.halt();
+        if counts.halted_by.is_none() {
+            if stop.time_limit.is_some_and(|t| start.elapsed() >= t) {
+                counts.halted_by = Some(Halt::Time);
+                sampler.halt();
+            } else if let Some(threshold) = stop.noise_threshold {
+                if counts.samples >= next_check {
+                    next_check = counts.samples + pixels;
+                    if relative_error(film.pixel_stats()) < threshold {
+                        counts.halted_by = Some(Halt::Noise);
+                        sampler.halt();
+                    }
+                }
+            }
         }
         match planned {
             Some(planned) => {
@@ -243,6 +325,34 @@ pub fn render_with(
         traced.hand_over(sampler, film, &mut in_sampler);
     }
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
+    if !counts.halted {
+        counts.halted_by = None;
+    }
     counts.sampler_seconds = in_sampler.as_secs_f64();
     counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use acr_plugins::PixelStats;
+
+    #[test]
+    fn relative_error_is_the_mean_standard_error_over_the_mean() {
+        // A pixel of samples 0.5 and 1.5: mean 1, sample variance 0.5, variance of the mean
+        // 0.25, standard error 0.5; over 1 + 0.01.
+        let mut noisy = PixelStats::default();
+        noisy.add(Spectrum::splat(0.5));
+        noisy.add(Spectrum::splat(1.5));
+        let mut flat = PixelStats::default();
+        flat.add(Spectrum::splat(2.0));
+        flat.add(Spectrum::splat(2.0));
+        let e = relative_error(&[noisy, flat]);
+        assert!((e - 0.5 * (0.5 / 1.01)).abs() < 1e-6, "{e}");
+        // A pixel with one sample has no estimate yet: it counts as 1.
+        let mut one = PixelStats::default();
+        one.add(Spectrum::splat(1.0));
+        assert_eq!(relative_error(&[one]), 1.0);
+        assert_eq!(relative_error(&[]), 0.0);
+    }
 }

@@ -56,8 +56,10 @@ pub struct Stats {
     pub integrator: String,
     /// Active dimensions of the rendering space, e.g. ["x","y","t"].
     pub dims: Vec<String>,
-    /// The time limit stopped the render before its budget was spent.
+    /// The time limit or the noise threshold stopped the render before its budget was spent.
     pub halted: bool,
+    /// What stopped it: "time" or "noise" (null when the budget was spent).
+    pub halted_by: Option<&'static str>,
     /// Clusters of the cluster sampler (null for other samplers).
     pub clusters: Option<u64>,
     /// Cells of the cluster sampler's grid (null for other samplers).

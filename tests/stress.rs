@@ -210,7 +210,7 @@ fn an_estimator_returning_nan_for_half_its_samples_leaves_a_finite_image_and_cou
         plugins.sampler.as_mut(),
         &mut film,
         7,
-        None,
+        &acr::render::Stop::default(),
         None,
         None,
     );
