@@ -204,6 +204,8 @@ fn render_writes_a_png_of_the_film_size_and_every_stats_key() {
         "dims",
         "clusters",
         "dropped_samples",
+        "halted",
+        "halted_by",
         "seconds",
         "mrays_per_s",
         "peak_rss_mb",
