@@ -449,8 +449,9 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
     info: PluginInfo {
         kind: Kind::Filter,
         name: "polynomial",
-        doc: "the paper's reconstruction: one additive Legendre polynomial per cluster of cells, \
-              fitted by weighted least squares and integrated over each pixel",
+        doc: "the paper's reconstruction: one additive Legendre polynomial per cluster of cells \
+              (plus a linear term per first-hit feature unless features is false), fitted by \
+              weighted least squares and integrated over each pixel",
         params: &[
             ParamSpec::new(
                 "degree",
@@ -475,13 +476,14 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
                 "omega",
                 ParamType::Float,
                 "the sampler's",
-                "grow the fit's own clusters with this ω of eq. 10 (smaller: larger clusters)",
+                "with features false: grow the fit's own clusters with this ω of eq. 10 \
+                 (smaller: larger clusters)",
             ),
             ParamSpec::new(
                 "maxclustercells",
                 ParamType::Integer,
                 "the sampler's",
-                "most cells in one of the fit's own clusters",
+                "with features false: most cells in one of the fit's own clusters",
             ),
             ParamSpec::new(
                 "noise",
