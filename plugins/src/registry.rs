@@ -351,6 +351,21 @@ pub(crate) fn float_in(
     in_range(params, name, v, range)
 }
 
+/// A string parameter that must be one of `options` (the first when absent): its index, or an
+/// error at its location naming the options.
+pub(crate) fn one_of(params: &ParamList, name: &str, options: &[&str]) -> Result<usize> {
+    let Some(v) = params.string(name)? else {
+        return Ok(0);
+    };
+    options.iter().position(|o| *o == v).ok_or_else(|| {
+        let loc = &params.get(name).expect("given").loc;
+        Error::at(
+            loc,
+            format!("{name} \"{v}\" is not known ({})", options.join(" or ")),
+        )
+    })
+}
+
 /// An integer parameter that must lie in `range`, or an error at its location.
 pub(crate) fn int_in(
     params: &ParamList,

@@ -18,10 +18,10 @@ use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
-use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
 use crate::sampler::ClusterSettings;
-use acr_parser::{Error, ParamType, Result};
+use acr_parser::{ParamType, Result};
 use rayon::prelude::*;
 use std::sync::Mutex;
 
@@ -539,16 +539,9 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     if p.bool_or("features", true)? {
         f = f.with_features(Some(tolerance));
     }
-    f = f.with_weights(match p.string("weights")? {
-        None | Some("count") => CellWeights::Count,
-        Some("uniform") => CellWeights::Uniform,
-        Some(other) => {
-            let loc = &p.get("weights").expect("given").loc;
-            return Err(Error::at(
-                loc,
-                format!("weights \"{other}\" is not known (count or uniform)"),
-            ));
-        }
+    f = f.with_weights(match one_of(p, "weights", &["count", "uniform"])? {
+        0 => CellWeights::Count,
+        _ => CellWeights::Uniform,
     });
     if p.get("omega").is_some() || p.get("maxclustercells").is_some() {
         let d = ClusterSettings::new(1);

@@ -3,7 +3,7 @@
 
 use super::ClusterSampler;
 use crate::cluster::build::ClusterParams;
-use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::sampler::{Sampler, SamplerBuild, SamplerSetup};
 use acr_parser::{Error, ParamType, Result};
 
@@ -222,16 +222,9 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
     }
     s.even_pixels = p.bool_or("evenpixels", true)?;
     s.log_features = p.bool_or("logfeatures", s.log_features)?;
-    s.priority = match p.string("priority")? {
-        None | Some("persample") => Priority::PerSample,
-        Some("paper") => Priority::Paper,
-        Some(other) => {
-            let loc = &p.get("priority").expect("given").loc;
-            return Err(Error::at(
-                loc,
-                format!("priority \"{other}\" is not known (persample or paper)"),
-            ));
-        }
+    s.priority = match one_of(p, "priority", &["persample", "paper"])? {
+        0 => Priority::PerSample,
+        _ => Priority::Paper,
     };
     // Cells beyond what memory can hold are refused before anything is allocated.
     let grid_cells = {
