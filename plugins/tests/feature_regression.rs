@@ -4,14 +4,11 @@
 //! feature, as the integrator records it. The feature explains the texture's edges, which the
 //! polynomial alone must either smooth or keep noisy.
 
-use acr_plugins::cluster::CellGrid;
-use acr_plugins::film::{Film, FilmSettings};
-use acr_plugins::filters::SamplerOutput;
 use acr_plugins::first_hit::Features;
 use acr_plugins::rng::mix64;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
 use acr_plugins::{Choice, Filter, Sampler, Setting, FILTERS};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 mod common;
 use common::sampler;
@@ -76,41 +73,12 @@ fn filter(name: &str, settings: &[&str]) -> Box<dyn Filter> {
     (e.build)(&c).unwrap()
 }
 
-/// The image `f` makes from the samples of `s`, the film collecting features as the renderer's
-/// does for a filter that reads them.
-fn render(mut s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
-    let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
-    if let Some((cell_size, bins)) = f.cell_layout() {
-        if !s.keeps_cells() || f.reads_features() {
-            let grid = CellGrid::new(space(), cell_size, bins);
-            film.collect_cells(grid, f.reads_features());
-        }
-    }
-    let mut batch = Vec::new();
-    while s.next_batch(&mut batch) {
-        let (radiance, features): (Vec<[f32; 3]>, Vec<Features>) = batch
-            .iter()
-            .map(|q| {
-                let (l, f) = sample(q);
-                ([l; 3], f)
-            })
-            .unzip();
-        s.observe(&batch, &radiance);
-        film.add_points(&batch, &radiance, Some(&features));
-        let samples: Vec<(Vec2, Vec3)> = batch
-            .iter()
-            .zip(&radiance)
-            .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
-            .collect();
-        film.add_samples(&samples);
-    }
-    f.reconstruct(
-        &film,
-        SamplerOutput {
-            partition: s.partition(),
-            cells: s.cells(),
-        },
-    )
+/// The image `f` makes from the samples of `s` on the textured field.
+fn render(s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
+    common::render_field(space(), s, f, |q| {
+        let (l, features) = sample(q);
+        ([l; 3], features)
+    })
 }
 
 /// RMS error against the exact pixels and the image mean over the exact mean, over 3 seeds.

@@ -2,13 +2,10 @@
 //! with a step edge, reconstructed from the same samples by box, gaussian and polynomial, and
 //! by polynomial after the cluster sampler; errors against the exact pixel integrals.
 
-use acr_plugins::cluster::CellGrid;
-use acr_plugins::film::{Film, FilmSettings};
-use acr_plugins::filters::SamplerOutput;
 use acr_plugins::rng::mix64;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
 use acr_plugins::{Choice, Filter, Sampler, Setting, FILTERS};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 mod common;
 use common::sampler;
@@ -60,33 +57,9 @@ fn filter(name: &str) -> Box<dyn Filter> {
     (e.build)(&c).unwrap()
 }
 
-/// The image `f` makes from the samples of `s` on the field.
-fn render(mut s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
-    let mut film = Film::new(FilmSettings::with_resolution(W, H), f.kernel());
-    if let Some((cell_size, bins)) = f.cell_layout() {
-        if !s.keeps_cells() {
-            film.collect_cells(CellGrid::new(space(), cell_size, bins), false);
-        }
-    }
-    let mut batch = Vec::new();
-    while s.next_batch(&mut batch) {
-        let radiance: Vec<[f32; 3]> = batch.iter().map(|q| [field(q); 3]).collect();
-        s.observe(&batch, &radiance);
-        film.add_points(&batch, &radiance, None);
-        let samples: Vec<(Vec2, Vec3)> = batch
-            .iter()
-            .zip(&radiance)
-            .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
-            .collect();
-        film.add_samples(&samples);
-    }
-    f.reconstruct(
-        &film,
-        SamplerOutput {
-            partition: s.partition(),
-            cells: s.cells(),
-        },
-    )
+/// The image `f` makes from the samples of `s` on the field (no first-hit features).
+fn render(s: Box<dyn Sampler>, f: &dyn Filter) -> Vec<Vec3> {
+    common::render_field(space(), s, f, |q| ([field(q); 3], [0.0; 7]))
 }
 
 /// RMS error against the exact pixels of `sampler_name` + `filter_name` at `spp`, over seeds,

@@ -1,7 +1,12 @@
 //! What the plugin tests share.
 
-use acr_plugins::space::RenderingSpace;
-use acr_plugins::{Choice, Sampler, SamplerSetup, SAMPLERS};
+use acr_plugins::cluster::CellGrid;
+use acr_plugins::film::{Film, FilmSettings};
+use acr_plugins::filters::SamplerOutput;
+use acr_plugins::first_hit::Features;
+use acr_plugins::space::{RenderingSpace, SamplePoint};
+use acr_plugins::{Choice, Filter, Sampler, SamplerSetup, SAMPLERS};
+use glam::{Vec2, Vec3};
 
 /// The sampler `name` on `space` at `spp`, built through the registry as the command line's
 /// `--spp` does.
@@ -17,4 +22,45 @@ pub fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dy
         reconstruction_reads_cells: true,
     };
     (e.build)(&Choice::new(None, name, None), &setup).unwrap()
+}
+
+/// The image `f` makes over `space` from the samples of `s` on a field that gives each point
+/// its radiance and first-hit features; the film collects cells (with the features) as the
+/// renderer's does for the filter. Not every test file renders.
+#[allow(dead_code)]
+pub fn render_field(
+    space: RenderingSpace,
+    mut s: Box<dyn Sampler>,
+    f: &dyn Filter,
+    field: impl Fn(&SamplePoint) -> ([f32; 3], Features),
+) -> Vec<Vec3> {
+    let mut film = Film::new(
+        FilmSettings::with_resolution(space.width(), space.height()),
+        f.kernel(),
+    );
+    if let Some((cell_size, bins)) = f.cell_layout() {
+        if !s.keeps_cells() || f.reads_features() {
+            let grid = CellGrid::new(space, cell_size, bins);
+            film.collect_cells(grid, f.reads_features());
+        }
+    }
+    let mut batch = Vec::new();
+    while s.next_batch(&mut batch) {
+        let (radiance, features): (Vec<[f32; 3]>, Vec<Features>) = batch.iter().map(&field).unzip();
+        s.observe(&batch, &radiance);
+        film.add_points(&batch, &radiance, Some(&features));
+        let samples: Vec<(Vec2, Vec3)> = batch
+            .iter()
+            .zip(&radiance)
+            .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
+            .collect();
+        film.add_samples(&samples);
+    }
+    f.reconstruct(
+        &film,
+        SamplerOutput {
+            partition: s.partition(),
+            cells: s.cells(),
+        },
+    )
 }
