@@ -372,6 +372,13 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
             f.non_finite
         );
     }
+    if counts.non_finite_features > 0 {
+        eprintln!(
+            "warning: {} samples had non-finite first-hit features; the polynomial fit's cells \
+             took them as 0",
+            counts.non_finite_features
+        );
+    }
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

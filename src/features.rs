@@ -111,16 +111,7 @@ impl FeatureImage {
             return;
         }
         let i = y as usize * self.width + x as usize;
-        let v = [
-            hit.albedo.x,
-            hit.albedo.y,
-            hit.albedo.z,
-            hit.normal.x,
-            hit.normal.y,
-            hit.normal.z,
-            hit.depth,
-        ];
-        for (s, v) in self.sums[i].iter_mut().zip(v) {
+        for (s, v) in self.sums[i].iter_mut().zip(hit.to_array()) {
             *s += f64::from(v);
         }
         self.counts[i] += 1;

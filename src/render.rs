@@ -118,7 +118,8 @@ pub struct RenderCounts {
     pub halted_by: Option<Halt>,
     /// Wall seconds spent in the sampler (its batches and what it learns from them).
     pub sampler_seconds: f64,
-    /// Samples whose first-hit features were not finite (set to 0 for the film's cells).
+    /// Samples whose first-hit features were not finite, counted when the film's cells keep
+    /// features (they take them as 0).
     pub non_finite_features: u64,
 }
 
@@ -164,8 +165,8 @@ struct Traced {
     radiance: Vec<[f32; 3]>,
     /// The film position and radiance of each sample kept.
     valid: Vec<(Vec2, Spectrum)>,
-    /// Each point's first-hit features, for the film's cells (values that are not finite
-    /// become 0 and are counted).
+    /// Each point's first-hit features, when the film's cells keep them (values that are not
+    /// finite become 0 and are counted); empty otherwise.
     features: Vec<Features>,
 }
 
@@ -182,11 +183,14 @@ impl Traced {
         self.valid.clear();
         self.radiance.clear();
         self.features.clear();
+        let keep_features = film.collects_features();
         for (q, &(l, rays, first_hit)) in self.batch.iter().zip(results) {
             counts.rays += u64::from(rays);
-            let (f, bad) = sanitized(first_hit.to_array());
-            counts.non_finite_features += u64::from(bad);
-            self.features.push(f);
+            if keep_features {
+                let (f, bad) = sanitized(first_hit.to_array());
+                counts.non_finite_features += u64::from(bad);
+                self.features.push(f);
+            }
             if let Some(f) = features.as_deref_mut() {
                 f.add(Vec2::from(q.film), &first_hit);
             }
@@ -206,7 +210,8 @@ impl Traced {
     /// Gives the batch to the sampler (its time added to `in_sampler`), then to the film.
     fn hand_over(&self, sampler: &mut dyn Sampler, film: &mut Film, in_sampler: &mut Duration) {
         timed(in_sampler, || sampler.observe(&self.batch, &self.radiance));
-        film.add_points(&self.batch, &self.radiance, Some(&self.features));
+        let features = film.collects_features().then_some(self.features.as_slice());
+        film.add_points(&self.batch, &self.radiance, features);
         film.add_samples(&self.valid);
     }
 }

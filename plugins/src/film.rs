@@ -409,6 +409,13 @@ impl Film {
         sums.add_batch(&self.located, radiance, features);
     }
 
+    /// Whether the film's cells keep the samples' first-hit features ([`Film::collect_cells`]).
+    pub fn collects_features(&self) -> bool {
+        self.cells
+            .as_ref()
+            .is_some_and(|(_, sums)| sums.keeps_features())
+    }
+
     /// The film's cells, when it collects them.
     pub fn cells(&self) -> Option<CellView<'_>> {
         self.cells.as_ref().map(|(grid, sums)| CellView {

@@ -8,8 +8,6 @@ pub const FEATURES: usize = 7;
 /// One sample's first-hit features: albedo r, g, b, normal x, y, z, depth.
 pub type Features = [f32; FEATURES];
 
-/// Index of the first albedo channel.
-pub const ALBEDO: usize = 0;
 /// Index of the normal's x.
 pub const NORMAL: usize = 3;
 /// Index of the depth.
