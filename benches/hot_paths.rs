@@ -265,6 +265,7 @@ fn sampler(name: &str, dims: Dims) -> Box<dyn Sampler> {
         spp: Some(SPP),
         seed: 1,
         reconstruction_reads_cells: false,
+        stream: Default::default(),
     };
     (entry.build)(&Choice::new(None, name, None), &setup).expect("sampler")
 }

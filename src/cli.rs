@@ -211,7 +211,8 @@ impl SamplerCostRun<'_> {
                 &mut scratch,
             )
             .map_err(|e| e.to_string())?;
-            let mut replay = Replay::new(plugins.sampler.spp(), &batches);
+            let mut replay =
+                Replay::new(plugins.sampler.spp(), plugins.sampler.streams(), &batches);
             let mut films = [plugins.film(self.scene), plugins.film(self.scene)];
             let [replayed, rendered] = &mut films;
             let integrator = &plugins.integrator;

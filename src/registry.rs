@@ -73,17 +73,19 @@ impl Plugins {
     /// has one, times the film's `scale`; row-major over the cropped film.
     pub fn image(&self, film: &Film) -> Vec<Spectrum> {
         let scale = film.settings().scale;
+        let filtered = |film: &Film| {
+            self.filter.reconstruct(
+                film,
+                SamplerOutput {
+                    partition: self.sampler.partition(),
+                    cells: self.sampler.cells(),
+                },
+            )
+        };
+        // Two streams: each reconstructed alone, the image their mean.
         self.sampler
             .reconstruct(film)
-            .unwrap_or_else(|| {
-                self.filter.reconstruct(
-                    film,
-                    SamplerOutput {
-                        partition: self.sampler.partition(),
-                        cells: self.sampler.cells(),
-                    },
-                )
-            })
+            .unwrap_or_else(|| film.per_stream(|f, _| filtered(f)))
             .into_iter()
             .map(|c| c * scale)
             .collect()
@@ -191,6 +193,7 @@ pub fn choose_for_scene(
         seed,
         // `choose` sets it from the filter it chooses.
         reconstruction_reads_cells: false,
+        stream: Default::default(),
     };
     choose(desc, overrides, setup, warnings)
 }

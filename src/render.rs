@@ -9,7 +9,7 @@ use crate::integrator::{Integrator, Radiance};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
 use acr_plugins::first_hit::{sanitized, Features};
-use acr_plugins::sampler::SOBOL_DIMS_USED;
+use acr_plugins::sampler::{IndexStream, SOBOL_DIMS_USED};
 use acr_plugins::{Film, RenderingSpace, SamplePoint, Sampler};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -163,8 +163,9 @@ struct Traced {
     batch: Vec<SamplePoint>,
     /// Each point's radiance, clamped by the film's limits; NaN where it was dropped.
     radiance: Vec<[f32; 3]>,
-    /// The film position and radiance of each sample kept.
-    valid: Vec<(Vec2, Spectrum)>,
+    /// The film position and radiance of each sample kept, by stream (the index's parity)
+    /// when the film keeps a paired sampler's two streams apart, else all in the first.
+    valid: [Vec<(Vec2, Spectrum)>; 2],
     /// Each point's first-hit features, when the film's cells keep them (values that are not
     /// finite become 0 and are counted); empty otherwise.
     features: Vec<Features>,
@@ -180,7 +181,8 @@ impl Traced {
         counts: &mut RenderCounts,
         mut features: Option<&mut FeatureImage>,
     ) {
-        self.valid.clear();
+        self.valid.iter_mut().for_each(Vec::clear);
+        let split = film.halves().is_some();
         self.radiance.clear();
         self.features.clear();
         let keep_features = film.collects_features();
@@ -196,7 +198,8 @@ impl Traced {
             }
             if is_valid_radiance(l) {
                 let l = film.settings().clamp(l);
-                self.valid.push((Vec2::from(q.film), l));
+                let stream = if split { q.index as usize & 1 } else { 0 };
+                self.valid[stream].push((Vec2::from(q.film), l));
                 self.radiance.push(l.to_array());
             } else {
                 counts.dropped += 1;
@@ -212,7 +215,13 @@ impl Traced {
         timed(in_sampler, || sampler.observe(&self.batch, &self.radiance));
         let features = film.collects_features().then_some(self.features.as_slice());
         film.add_points(&self.batch, &self.radiance, features);
-        film.add_samples(&self.valid);
+        match film.halves() {
+            Some(_) => {
+                film.add_stream_samples(0, &self.valid[0]);
+                film.add_stream_samples(1, &self.valid[1]);
+            }
+            None => film.add_samples(&self.valid[0]),
+        }
     }
 }
 
@@ -249,16 +258,28 @@ pub fn render_with(
     let full_width = u64::from(scene.film.resolution.0);
     let space = rendering_space(scene);
     let mut counts = RenderCounts::default();
+    if sampler.streams() == 2 {
+        film.split_streams();
+    }
     if let Some(p) = progress {
         p.set_length(space.pixels() * u64::from(sampler.spp()));
     }
+    // A paired sampler's streams draw the integrator's decisions from sequences of their own:
+    // sharing one, a sample and its neighbour in the other stream would be a stratified pair,
+    // and one stream's values would tell where the other's went.
+    let streams = sampler.streams().max(1);
     let trace = |batch: &[SamplePoint], results: &mut Vec<SampleResult>| {
         batch
             .par_iter()
             .map(|q| {
                 let key = u64::from(q.pixel[1]) * full_width + u64::from(q.pixel[0]);
+                let own = IndexStream {
+                    count: streams,
+                    which: q.index % streams,
+                };
                 // The integrator's decisions come after the dims the sampler drew.
-                let mut stream = SampleStream::new(key, q.index, seed, SOBOL_DIMS_USED);
+                let mut stream =
+                    SampleStream::new(key, q.index / streams, own.seed(seed), SOBOL_DIMS_USED);
                 let ray = scene.camera.generate_ray(&CameraSample {
                     film: Vec2::from(q.film),
                     lens: Vec2::from(q.lens),

@@ -59,20 +59,26 @@ impl Sampler for Recording<'_> {
     fn plans_ahead(&self) -> bool {
         self.inner.plans_ahead()
     }
+
+    fn streams(&self) -> u32 {
+        self.inner.streams()
+    }
 }
 
 /// Gives recorded batches again, in order, doing no work of its own but copying them out.
 pub struct Replay<'a> {
     spp: u32,
+    streams: u32,
     batches: &'a [Vec<SamplePoint>],
     next: usize,
 }
 
 impl<'a> Replay<'a> {
-    /// Gives `batches` again, for a render of `spp` samples per pixel.
-    pub fn new(spp: u32, batches: &'a [Vec<SamplePoint>]) -> Self {
+    /// Gives `batches` again, for a render of `spp` samples per pixel in `streams` streams.
+    pub fn new(spp: u32, streams: u32, batches: &'a [Vec<SamplePoint>]) -> Self {
         Self {
             spp,
+            streams,
             batches,
             next: 0,
         }
@@ -104,5 +110,9 @@ impl Sampler for Replay<'_> {
 
     fn plans_ahead(&self) -> bool {
         true
+    }
+
+    fn streams(&self) -> u32 {
+        self.streams
     }
 }

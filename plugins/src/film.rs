@@ -215,6 +215,9 @@ pub struct Film {
     cells: Option<(CellGrid, CellSums)>,
     /// The cell and offsets of each point of the batch being added (reused).
     located: Vec<(u32, [f32; MAX_DIMS])>,
+    /// The two streams' films, when the samples come in two ([`Film::split_streams`]): the
+    /// splats and cells go there, and this film keeps the pixel statistics of both.
+    halves: Option<Box<[Film; 2]>>,
 }
 
 /// Film columns a [`Prepared`] sample can reach: enough for filters of radius up to 3.5
@@ -382,6 +385,53 @@ impl Film {
             prepared: Vec::new(),
             cells: None,
             located: Vec::new(),
+            halves: None,
+        }
+    }
+
+    /// Keeps the two sample streams of a paired sampler apart (a sample's stream is its
+    /// index's parity): each gets a film of its own, and the image is their mean, so that
+    /// neither stream's share of a pixel depends on the other's values. Called before any
+    /// sample is added.
+    pub fn split_streams(&mut self) {
+        if self.halves.is_some() {
+            return;
+        }
+        let half = self.clone();
+        // The splats and cells live in the halves only.
+        self.cells = None;
+        self.sums = Vec::new();
+        self.halves = Some(Box::new([half.clone(), half]));
+    }
+
+    /// The two streams' films, when split.
+    pub fn halves(&self) -> Option<&[Film; 2]> {
+        self.halves.as_deref()
+    }
+
+    /// The image `image` makes of this film, or when it is split, the mean of the images it
+    /// makes of each stream's film (`image` gets the stream's number).
+    pub fn per_stream(&self, image: impl Fn(&Film, usize) -> Vec<Spectrum>) -> Vec<Spectrum> {
+        match self.halves() {
+            Some([a, b]) => image(a, 0)
+                .into_iter()
+                .zip(image(b, 1))
+                .map(|(x, y)| (x + y) * 0.5)
+                .collect(),
+            None => image(self, 0),
+        }
+    }
+
+    /// Adds samples of stream `stream` (raster position and radiance, sorted by row) to that
+    /// stream's film, and their statistics to this one's; the same as
+    /// [`Film::add_samples`] when the film is not split.
+    pub fn add_stream_samples(&mut self, stream: usize, samples: &[(Vec2, Spectrum)]) {
+        match self.halves.as_mut() {
+            Some(h) => {
+                h[stream & 1].add_samples(samples);
+                self.add_stats(samples);
+            }
+            None => self.add_samples(samples),
         }
     }
 
@@ -402,6 +452,18 @@ impl Film {
         radiance: &[[f32; 3]],
         features: Option<&[Features]>,
     ) {
+        if let Some(h) = self.halves.as_mut() {
+            // Each stream's points to its own film's cells, in order.
+            for (s, half) in h.iter_mut().enumerate() {
+                let keep = |k: &usize| batch[*k].index as usize & 1 == s;
+                let ks: Vec<usize> = (0..batch.len()).filter(keep).collect();
+                let b: Vec<SamplePoint> = ks.iter().map(|&k| batch[k]).collect();
+                let r: Vec<[f32; 3]> = ks.iter().map(|&k| radiance[k]).collect();
+                let f: Option<Vec<Features>> = features.map(|f| ks.iter().map(|&k| f[k]).collect());
+                half.add_points(&b, &r, f.as_deref());
+            }
+            return;
+        }
         let Some((grid, sums)) = self.cells.as_mut() else {
             return;
         };
@@ -411,6 +473,9 @@ impl Film {
 
     /// Whether the film's cells keep the samples' first-hit features ([`Film::collect_cells`]).
     pub fn collects_features(&self) -> bool {
+        if let Some(h) = &self.halves {
+            return h[0].collects_features();
+        }
         self.cells
             .as_ref()
             .is_some_and(|(_, sums)| sums.keeps_features())
@@ -552,6 +617,9 @@ impl Film {
     /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
     /// `scale` is applied on output, not here).
     pub fn pixels(&self) -> Vec<Spectrum> {
+        if let Some(h) = &self.halves {
+            return h[0].mean_with(&h[1]);
+        }
         self.sums
             .iter()
             .map(|s| {
@@ -567,6 +635,22 @@ impl Film {
                 } else {
                     Spectrum::ZERO
                 }
+            })
+            .collect()
+    }
+}
+
+impl Film {
+    /// The mean of this film's image and `other`'s (of the same size), pixel by pixel; a pixel
+    /// that one of them has no weight at takes the other's value.
+    fn mean_with(&self, other: &Film) -> Vec<Spectrum> {
+        let (a, b) = (self.pixels(), other.pixels());
+        let weighed = |f: &Film, i: usize| f.sums[i][3] != 0.0;
+        (0..a.len())
+            .map(|i| match (weighed(self, i), weighed(other, i)) {
+                (true, false) => a[i],
+                (false, true) => b[i],
+                _ => (a[i] + b[i]) * 0.5,
             })
             .collect()
     }

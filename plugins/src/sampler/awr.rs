@@ -210,7 +210,14 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "1",
                 "soft threshold of the detail coefficients, in noise standard deviations",
             ),
+            super::paired::STREAMS,
         ],
     },
-    build,
+    build: build_streams,
 };
+
+/// Builds the sampler as two streams, each placed by the other's values (or as one, with
+/// `streams 1`).
+fn build_streams(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn super::Sampler>> {
+    super::paired::wrap(c, setup, build)
+}

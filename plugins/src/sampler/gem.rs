@@ -201,7 +201,14 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "1",
                 "a coarser scale is kept while its squared change <= gamma x the variances",
             ),
+            super::paired::STREAMS,
         ],
     },
-    build,
+    build: build_streams,
 };
+
+/// Builds the sampler as two streams, each placed by the other's values (or as one, with
+/// `streams 1`).
+fn build_streams(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn super::Sampler>> {
+    super::paired::wrap(c, setup, build)
+}

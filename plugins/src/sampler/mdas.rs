@@ -70,6 +70,8 @@ pub struct MdasSampler {
     spp: u32,
     init_spp: u32,
     seed: u64,
+    /// Which interleaved stream of sample indices it gives.
+    stream: super::IndexStream,
     leaf_samples: usize,
     factor: f64,
     dim_scale: f32,
@@ -367,7 +369,7 @@ impl MdasSampler {
         points.sort_by_key(|q| (q.pixel[1], q.pixel[0]));
         for q in &mut points {
             let i = self.space.index_of(q.pixel);
-            q.index = self.per_pixel[i];
+            q.index = self.stream.index(self.per_pixel[i]);
             self.per_pixel[i] += 1;
         }
         self.pending = points;
@@ -387,6 +389,8 @@ impl MdasSampler {
             let p = self.space.pixel(i);
             for k in 0..self.init_spp {
                 let key = pixel_key(p, self.seed, SALT);
+                // The stream's own indices, so that two streams draw different points.
+                let k = self.stream.index(k);
                 let mut rng = Pcg32::new(super::mix64(key ^ u64::from(k)), u64::from(k));
                 let mut at = [0.0; MAX_DIMS];
                 at[0] = p[0] as f32 + rng.next_f32();
@@ -546,6 +550,7 @@ fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
         spp,
         init_spp,
         seed: setup.seed,
+        stream: setup.stream,
         leaf_samples: int_in(p, "leafsamples", 8, 2..=1024)? as usize,
         factor: float_in(p, "factor", 0.25, 0.0..=1.0)?,
         dim_scale: float_in(p, "dimscale", 1.0, 1e-3..=1e3)? as f32,
@@ -609,7 +614,14 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "1",
                 "pixels one unit of time or lens counts as when choosing the longest axis",
             ),
+            super::paired::STREAMS,
         ],
     },
-    build,
+    build: build_streams,
 };
+
+/// Builds the sampler as two streams, each placed by the other's values (or as one, with
+/// `streams 1`).
+fn build_streams(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn super::Sampler>> {
+    super::paired::wrap(c, setup, build)
+}

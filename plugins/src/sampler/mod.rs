@@ -7,6 +7,7 @@ mod cluster;
 mod gem;
 mod halton;
 mod mdas;
+mod paired;
 mod pixel_rounds;
 mod random;
 mod sobol;
@@ -50,6 +51,25 @@ pub trait Sampler: Send {
     /// The radiance of each point of `batch`, in order; adaptive samplers learn from it.
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
         let _ = (batch, radiance);
+    }
+
+    /// Learns from points another sampler planned (the other stream of a [`paired`] sampler),
+    /// as [`Sampler::observe`] learns from its own; by default, the same.
+    fn observe_other(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        self.observe(batch, radiance);
+    }
+
+    /// Its own batch was traced, but its values went to the other stream: what `observe` does
+    /// for the batch's bookkeeping, without learning from the values. By default, nothing.
+    fn retire(&mut self, batch: &[SamplePoint]) {
+        let _ = batch;
+    }
+
+    /// How many sample streams the points come in: 2 when each stream's points are decided from
+    /// the other's values (a [`paired`] sampler). A point's stream is its index's parity; the
+    /// film keeps the streams apart and the image is their mean.
+    fn streams(&self) -> u32 {
+        1
     }
 
     /// Asks the sampler to stop early (a time limit): it ends its current pass, so that every
@@ -122,6 +142,47 @@ pub struct SamplerSetup {
     /// Whether the reconstruction reads the sampler's cells (the polynomial filter): a sampler
     /// that keeps cells sums their radiance and sample positions only then.
     pub reconstruction_reads_cells: bool,
+    /// Which of interleaved streams of sample indices the sampler gives (all of them, unless it
+    /// is one stream of a [`paired`] sampler).
+    pub stream: IndexStream,
+}
+
+/// One of `count` interleaved streams of sample indices: a sampler's `i`th sample of a pixel
+/// has index `i * count + which`, so that no two streams' samples share an index (which keys
+/// the integrator's per-sample random stream) and the film tells the streams apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IndexStream {
+    /// How many streams.
+    pub count: u32,
+    /// Which one, below `count`.
+    pub which: u32,
+}
+
+impl IndexStream {
+    /// The only stream: every index.
+    pub const ALL: Self = Self { count: 1, which: 0 };
+
+    /// The seed of this stream's own random decisions: `seed` for the first stream, another
+    /// for each further one (the streams' points are not to repeat each other's choices).
+    pub fn seed(self, seed: u64) -> u64 {
+        if self.which == 0 {
+            seed
+        } else {
+            mix64(seed ^ mix64(u64::from(self.which)))
+        }
+    }
+
+    /// The index of a pixel's `i`th sample of this stream.
+    #[inline]
+    pub fn index(self, i: u32) -> u32 {
+        i * self.count + self.which
+    }
+}
+
+impl Default for IndexStream {
+    fn default() -> Self {
+        Self::ALL
+    }
 }
 
 /// Builds a sampler from its checked parameters.

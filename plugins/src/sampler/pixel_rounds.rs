@@ -5,7 +5,7 @@
 // Channel and dim loops index several small arrays at once, as the formulas do.
 #![allow(clippy::needless_range_loop)]
 
-use super::{pixel_key, Sampler, SamplerSetup, BATCH_SAMPLES};
+use super::{pixel_key, IndexStream, Sampler, SamplerSetup, BATCH_SAMPLES};
 use crate::film::{luminance, Film, Spectrum};
 use crate::registry::{int_in, ParamSpec};
 use crate::space::{RenderingSpace, SamplePoint};
@@ -88,6 +88,8 @@ pub(crate) struct PixelRounds<M> {
     spp: u32,
     seed: u64,
     salt: u64,
+    /// Which interleaved stream of sample indices it gives.
+    stream: IndexStream,
     /// Samples each pixel gets in the round under way.
     plan: Vec<u32>,
     /// The next pixel of the plan to emit.
@@ -125,6 +127,7 @@ impl<M: PixelMethod> PixelRounds<M> {
             spp,
             seed,
             salt,
+            stream: IndexStream::ALL,
             plan: vec![init; pixels],
             cursor: 0,
             unplanned: rest,
@@ -134,6 +137,12 @@ impl<M: PixelMethod> PixelRounds<M> {
             rounds: 1,
             halted: false,
         }
+    }
+
+    /// The same sampler giving stream `stream`'s sample indices.
+    pub(crate) fn with_stream(mut self, stream: IndexStream) -> Self {
+        self.stream = stream;
+        self
     }
 
     /// Plans the next round from the method's error map; false when nothing is left.
@@ -191,15 +200,10 @@ pub(crate) fn build<M: PixelMethod + 'static>(
         1..=i64::from(spp),
     )?;
     let rounds = int_in(params, "rounds", 4, 1..=64)?;
-    Ok(Box::new(PixelRounds::new(
-        method,
-        setup.space,
-        spp,
-        init,
-        rounds,
-        setup.seed,
-        salt,
-    )))
+    Ok(Box::new(
+        PixelRounds::new(method, setup.space, spp, init, rounds, setup.seed, salt)
+            .with_stream(setup.stream),
+    ))
 }
 
 /// `n` samples allocated in proportion to `weights` (largest remainders get the rest; ties to
@@ -258,7 +262,7 @@ impl<M: PixelMethod> Sampler for PixelRounds<M> {
         while self.cursor < self.plan.len() && (out.len() as u64) < BATCH_SAMPLES {
             let i = self.cursor;
             for _ in 0..self.plan[i] {
-                out.push(self.point(i, self.given[i]));
+                out.push(self.point(i, self.stream.index(self.given[i])));
                 self.given[i] += 1;
             }
             self.cursor += 1;

@@ -3,6 +3,7 @@
 //! (pixel, seed). The first 2^k points of a pixel form a (0, k, 1)-net in each dim, so spp = 16
 //! puts one point in each 1/16 of every 1D projection.
 
+use super::IndexStream;
 use super::{pixel_key, Pcg32, PixelCursor, PixelPattern, Sampler};
 use super::{SamplerBuild, SamplerSetup};
 use crate::registry::{Choice, Entry, Kind, ParamSpec, PluginInfo};
@@ -26,6 +27,7 @@ pub const SOBOL_DIMS_USED: u32 = 5;
 pub struct SobolSampler {
     cursor: PixelCursor,
     seed: u64,
+    stream: IndexStream,
 }
 
 impl SobolSampler {
@@ -34,7 +36,17 @@ impl SobolSampler {
         Self {
             cursor: PixelCursor::new(space, spp),
             seed,
+            stream: IndexStream::ALL,
         }
+    }
+
+    /// The same sampler labelling its samples with stream `stream`'s indices: a pixel's points
+    /// are still its sequence's first ones (the even points alone of a Sobol sequence would
+    /// all lie in one half of the pixel), and only the index that keys the integrator's stream
+    /// and tells the film the stream changes.
+    pub fn with_stream(mut self, stream: IndexStream) -> Self {
+        self.stream = stream;
+        self
     }
 }
 
@@ -51,7 +63,11 @@ impl PixelPattern for SobolSampler {
 
     fn pixel(&self, p: [u32; 2], indices: std::ops::Range<u32>, out: &mut Vec<SamplePoint>) {
         let scramble = Scramble::of(p, self.seed);
-        out.extend(indices.map(|index| self.point(p, index, scramble)));
+        let stream = self.stream;
+        out.extend(indices.map(|i| SamplePoint {
+            index: stream.index(i),
+            ..self.point(p, i, scramble)
+        }));
     }
 }
 

@@ -9,8 +9,20 @@ use acr_plugins::{Choice, Filter, Sampler, SamplerSetup, SAMPLERS};
 use glam::{Vec2, Vec3};
 
 /// The sampler `name` on `space` at `spp`, built through the registry as the command line's
-/// `--spp` does.
+/// `--spp` does. Not every test file uses it.
+#[allow(dead_code)]
 pub fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dyn Sampler> {
+    sampler_with(Choice::new(None, name, None), space, spp, seed)
+}
+
+/// The sampler of `choice` (a name and parameters) on `space` at `spp`.
+pub fn sampler_with(
+    choice: Choice,
+    space: RenderingSpace,
+    spp: u32,
+    seed: u64,
+) -> Box<dyn Sampler> {
+    let name = choice.name.clone();
     let e = SAMPLERS
         .iter()
         .find(|e| e.info.name == name)
@@ -20,8 +32,9 @@ pub fn sampler(name: &str, space: RenderingSpace, spp: u32, seed: u64) -> Box<dy
         spp: Some(spp),
         seed,
         reconstruction_reads_cells: true,
+        stream: Default::default(),
     };
-    (e.build)(&Choice::new(None, name, None), &setup).unwrap()
+    (e.build)(&choice, &setup).unwrap()
 }
 
 /// The image `f` makes over `space` from the samples of `s` on a field that gives each point
@@ -44,23 +57,32 @@ pub fn render_field(
             film.collect_cells(grid, f.reads_features());
         }
     }
+    // A paired sampler's two streams are kept apart, as the render loop does.
+    if s.streams() == 2 {
+        film.split_streams();
+    }
     let mut batch = Vec::new();
     while s.next_batch(&mut batch) {
         let (radiance, features): (Vec<[f32; 3]>, Vec<Features>) = batch.iter().map(&field).unzip();
         s.observe(&batch, &radiance);
         film.add_points(&batch, &radiance, Some(&features));
-        let samples: Vec<(Vec2, Vec3)> = batch
-            .iter()
-            .zip(&radiance)
-            .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
-            .collect();
-        film.add_samples(&samples);
+        for stream in 0..s.streams() {
+            let samples: Vec<(Vec2, Vec3)> = batch
+                .iter()
+                .zip(&radiance)
+                .filter(|(q, _)| q.index % s.streams() == stream)
+                .map(|(q, l)| (Vec2::from(q.film), Vec3::from_array(*l)))
+                .collect();
+            film.add_stream_samples(stream as usize, &samples);
+        }
     }
-    f.reconstruct(
-        &film,
-        SamplerOutput {
-            partition: s.partition(),
-            cells: s.cells(),
-        },
-    )
+    film.per_stream(|half, _| {
+        f.reconstruct(
+            half,
+            SamplerOutput {
+                partition: s.partition(),
+                cells: s.cells(),
+            },
+        )
+    })
 }

@@ -134,7 +134,8 @@ impl ClusterSampler {
         let cells = grid.len();
         let pixels = space.pixels();
         Self {
-            init: SobolSampler::new(space, settings.init_spp, seed ^ SALT),
+            init: SobolSampler::new(space, settings.init_spp, seed ^ SALT)
+                .with_stream(settings.stream),
             remaining: pixels * u64::from(settings.spp - settings.init_spp),
             settings,
             seed,
@@ -304,12 +305,16 @@ impl ClusterSampler {
             self.draw_pixels(&picks, out);
             let (init, grid) = (&self.init, &self.grid);
             let seed = init.seed();
+            let stream = self.settings.stream;
             self.round_cells.resize(out.len(), (0, [0.0; MAX_DIMS]));
             out.par_iter_mut()
                 .zip(self.round_cells.par_iter_mut())
                 .with_min_len(256)
                 .for_each(|(q, slot)| {
-                    *q = init.point(q.pixel, q.index, Scramble::of(q.pixel, seed));
+                    // The pixel's next point of its sequence, labelled with the stream's index.
+                    let local = q.index;
+                    *q = init.point(q.pixel, local, Scramble::of(q.pixel, seed));
+                    q.index = stream.index(local);
                     let (cell, off) = grid.locate(q);
                     *slot = (cell as u32, off);
                 });
@@ -438,7 +443,7 @@ impl ClusterSampler {
                 let cell = cells[slot];
                 let mut q = self.grid.point(cell as usize, &u);
                 let p = self.space.index_of(q.pixel);
-                q.index = self.pixel_count[p];
+                q.index = self.settings.stream.index(self.pixel_count[p]);
                 self.pixel_count[p] += 1;
                 points.push((q, cell, u));
             }
@@ -713,6 +718,39 @@ impl Sampler for ClusterSampler {
         // A round is one batch: update now.
         let clusters = self.update(clusters);
         self.spare.push((cells, clusters));
+        if self.phase == Phase::Done {
+            self.finish();
+        }
+    }
+
+    fn observe_other(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
+        // The other stream's points: their cells found here, their values learnt as this
+        // sampler's own would be.
+        let mut cells = std::mem::take(&mut self.round_cells);
+        self.grid.locate_all(batch, &mut cells);
+        self.sums.add_batch(&cells, radiance, None);
+        if self.clustering.is_some() {
+            for (&(cell, _), l) in cells.iter().zip(radiance) {
+                if !l[0].is_nan() {
+                    self.touched[cell as usize / 64] |= 1 << (cell % 64);
+                }
+            }
+            self.update(Vec::new());
+        }
+        self.round_cells = cells;
+    }
+
+    fn retire(&mut self, batch: &[SamplePoint]) {
+        // Its own round, traced for the other stream: only the clusters it sampled are queued
+        // again with their new sample counts.
+        let round = match self.in_flight.front() {
+            Some(r) if r.0.len() == batch.len() => self.in_flight.pop_front(),
+            _ => None,
+        };
+        if let Some((cells, clusters)) = round {
+            let clusters = self.update(clusters);
+            self.spare.push((cells, clusters));
+        }
         if self.phase == Phase::Done {
             self.finish();
         }

@@ -4,7 +4,7 @@
 use super::ClusterSampler;
 use crate::cluster::build::ClusterParams;
 use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
-use crate::sampler::{Sampler, SamplerBuild, SamplerSetup};
+use crate::sampler::{IndexStream, Sampler, SamplerBuild, SamplerSetup};
 use acr_parser::{Error, ParamType, Result};
 
 /// How the next clusters to sample are chosen.
@@ -52,6 +52,8 @@ pub struct ClusterSettings {
     /// Sum each cell's radiance and sample positions, for a reconstruction that reads the
     /// cells (the polynomial filter); the sampler itself needs only counts and luminance.
     pub keep_radiance: bool,
+    /// Which interleaved stream of sample indices it gives (see [`IndexStream`]).
+    pub stream: IndexStream,
 }
 
 impl ClusterSettings {
@@ -84,6 +86,7 @@ impl ClusterSettings {
             // 0.90 with, 0.99 without); motion-blur-3d at 16 spp 0.92 with, 1.38 without.
             log_features: true,
             keep_radiance: true,
+            stream: IndexStream::ALL,
         }
     }
 
@@ -191,10 +194,17 @@ pub(in crate::sampler) const ENTRY: Entry<SamplerBuild> = Entry {
                 "persample",
                 "which clusters get samples: persample (err x cells / samples) or paper (err)",
             ),
+            crate::sampler::paired::STREAMS,
         ],
     },
-    build,
+    build: build_streams,
 };
+
+/// Builds the sampler as two streams, each placed by the other's values (or as one, with
+/// `streams 1`).
+fn build_streams(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn crate::sampler::Sampler>> {
+    crate::sampler::paired::wrap(c, setup, build)
+}
 
 /// Builds the sampler from its choice (the registry entry's `build`).
 pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
@@ -202,6 +212,7 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
     let spp = crate::sampler::pixel_samples(p, setup)?;
     let mut s = ClusterSettings::new(spp);
     s.keep_radiance = setup.reconstruction_reads_cells;
+    s.stream = setup.stream;
     s.omega = float_in(p, "omega", s.omega, 1e-3..=1e3)?;
     s.cell_size = float_in(p, "cellsize", s.cell_size, 0.125..=64.0)?;
     s.bins = int_in(p, "bins", s.bins as i32, 1..=16)?;

@@ -288,6 +288,7 @@ fn bad_knobs_are_located_errors() {
         spp: None,
         seed: 1,
         reconstruction_reads_cells: true,
+        stream: Default::default(),
     };
     for (arg, want) in [
         ("sampler.omega=0", "omega 0 is out of range"),
