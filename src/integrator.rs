@@ -436,8 +436,21 @@ fn direct_li(
     if bsdf.has_non_specular() && !scene.lights.is_empty() {
         match strategy {
             DirectStrategy::All => {
-                for i in 0..scene.lights.len() as u32 {
-                    l += estimate_direct(scene, &si, &bsdf, i, 1.0, stream, &mut tally.rays);
+                // pbrt-v3's UniformSampleAllLights: each light's `nsamples`, averaged.
+                for (i, &n) in scene.light_samples.iter().enumerate() {
+                    let mut sum = Spectrum::ZERO;
+                    for _ in 0..n {
+                        sum += estimate_direct(
+                            scene,
+                            &si,
+                            &bsdf,
+                            i as u32,
+                            1.0,
+                            stream,
+                            &mut tally.rays,
+                        );
+                    }
+                    l += sum / n as f32;
                 }
             }
             DirectStrategy::One => {

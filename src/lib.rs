@@ -18,6 +18,8 @@ pub mod lightdistrib;
 pub mod material;
 pub mod metrics;
 pub mod microfacet;
+pub mod noise;
+pub mod procedural;
 pub mod registry;
 pub mod render;
 pub mod replay;

@@ -40,6 +40,9 @@ pub struct Scene {
     pub accel: Accel,
     /// Every light.
     pub lights: Vec<Light>,
+    /// Shadow samples per light per shading point for `directlighting`'s "all" strategy (the
+    /// area and infinite lights' `nsamples`, pbrt-v3's; 1 for the others).
+    pub light_samples: Vec<u32>,
     /// Light choice for next-event estimation, one per strategy (spatial built on first use).
     light_choice: LightChoices,
     /// Indices of infinite lights (seen by rays that escape).
@@ -170,6 +173,7 @@ struct Builder<'a> {
     warned: HashSet<String>,
     surfaces: Vec<Surface>,
     lights: Vec<Light>,
+    light_samples: Vec<u32>,
     /// Area lights waiting for the world's bounds: (light description, surface index).
     area_lights: Vec<(Arc<PluginDesc>, PrimKind, u32)>,
 }
@@ -466,8 +470,6 @@ impl Builder<'_> {
             }
             "infinite" => {
                 let l = rgb_param(params, "L", Spectrum::ONE)? * scale;
-                let _ = params.int("samples")?;
-                let _ = params.int("nsamples")?;
                 let map = match params.string("mapname")? {
                     Some(name) if !name.is_empty() => {
                         let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
@@ -540,6 +542,30 @@ fn render_from_world(camera: &acr_parser::CameraDesc) -> Result<DMat4> {
 }
 
 /// An RGB-valued parameter (rgb, spectrum or blackbody) or its default.
+/// Most shadow samples a light may ask for per shading point.
+const MAX_LIGHT_SAMPLES: i32 = 4096;
+
+/// An area or infinite light's shadow samples per shading point: pbrt-v3's
+/// `FindOneInt("samples", FindOneInt("nsamples", 1))`; below 1 counts as 1 (pbrt-v3 then takes
+/// one sample), above [`MAX_LIGHT_SAMPLES`] is an error at the parameter.
+fn light_sample_count(params: &ParamList) -> Result<u32> {
+    let nsamples = params.int_or("nsamples", 1)?;
+    let n = params.int_or("samples", nsamples)?;
+    if n > MAX_LIGHT_SAMPLES {
+        let name = if params.get("samples").is_some() {
+            "samples"
+        } else {
+            "nsamples"
+        };
+        let loc = &params.get(name).expect("given").loc;
+        return Err(Error::at(
+            loc,
+            format!("{name} {n} is more than {MAX_LIGHT_SAMPLES} shadow samples per point"),
+        ));
+    }
+    Ok(n.max(1) as u32)
+}
+
 pub fn rgb_param(params: &ParamList, name: &str, default: Spectrum) -> Result<Spectrum> {
     Ok(crate::texture::spectrum_value(params, name)?.unwrap_or(default))
 }
@@ -588,6 +614,7 @@ impl Scene {
             warned: HashSet::new(),
             surfaces: Vec::new(),
             lights: Vec::new(),
+            light_samples: Vec::new(),
             area_lights: Vec::new(),
         };
         let mut accel = Accel::default();
@@ -683,8 +710,7 @@ impl Scene {
             let l_emit =
                 rgb_param(params, "L", Spectrum::ONE)? * rgb_param(params, "scale", Spectrum::ONE)?;
             let two_sided = params.bool_or("twosided", false)?;
-            let _ = params.int("nsamples")?;
-            let _ = params.int("samples")?;
+            let samples = light_sample_count(params)?;
             let area = prim_area(&accel.world, kind);
             if area > 0.0 && l_emit.max_element() > 0.0 {
                 b.lights.push(Light::Area {
@@ -693,6 +719,7 @@ impl Scene {
                     two_sided,
                     area,
                 });
+                b.light_samples.push(samples);
                 b.surfaces[surface as usize].area_light = Some((b.lights.len() - 1) as u32);
             }
         }
@@ -703,7 +730,12 @@ impl Scene {
                 world_radius,
                 &main_dir,
             )? {
+                let samples = match light {
+                    Light::Infinite { .. } => light_sample_count(&l.plugin.params)?,
+                    _ => 1,
+                };
                 b.lights.push(light);
+                b.light_samples.push(samples);
             }
         }
         let materials =
@@ -737,6 +769,7 @@ impl Scene {
                 bounds: (lo, hi),
             },
             lights: b.lights,
+            light_samples: b.light_samples,
             infinite_lights,
             materials,
             surfaces: b.surfaces,

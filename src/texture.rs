@@ -1,5 +1,6 @@
 //! Float and spectrum textures (pbrt-v3's textures/*): constant, scale, mix, checkerboard (2D and
-//! 3D), imagemap, bilerp and uv, with pbrt-v3's 2D mappings (uv, spherical, cylindrical,
+//! 3D), imagemap, bilerp, uv, and the procedural fbm, wrinkled, windy, marble and dots
+//! ([`crate::procedural`]), with pbrt-v3's 2D mappings (uv, spherical, cylindrical,
 //! planar), and the helper that turns a material parameter (a value or a `"texture"`
 //! reference) into a texture.
 //!
@@ -18,6 +19,7 @@
 
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
 use crate::image_io::{read_image, RgbImage};
+use crate::procedural::{in_dot, NoisePattern};
 use crate::spectrum::{is_spectrum_type, luminance, spectrum_param_to_rgb, srgb_to_linear};
 use acr_parser::{
     Error, Loc, Param, ParamList, ParamType, Result, SceneDescription, TextureValue, Values,
@@ -386,6 +388,23 @@ pub enum Texture<T> {
         /// Texture coordinates.
         mapping: Mapping2D,
     },
+    /// pbrt-v3's 3D noise textures (`fbm`, `wrinkled`, `windy`, `marble`), at the hit point in
+    /// texture space.
+    Noise {
+        /// Texture-from-render.
+        texture_from_render: Mat4,
+        /// Which pattern, with its parameters.
+        pattern: NoisePattern,
+    },
+    /// pbrt-v3's `dots`: `inside` on randomly placed dots, `outside` elsewhere.
+    Dots {
+        /// Texture coordinates.
+        mapping: Mapping2D,
+        /// On a dot.
+        inside: Arc<Texture<T>>,
+        /// Off the dots.
+        outside: Arc<Texture<T>>,
+    },
 }
 
 /// A float-valued texture.
@@ -443,6 +462,30 @@ impl<T: TexValue> Texture<T> {
             Texture::Uv { mapping } => {
                 let st = mapping.map(si);
                 T::from_uv(st.x, st.y)
+            }
+            Texture::Noise {
+                texture_from_render,
+                pattern,
+            } => {
+                let p = texture_from_render.project_point3(si.p);
+                match pattern {
+                    // Built for spectrum textures only.
+                    NoisePattern::Marble { .. } => {
+                        T::from_texel(pattern.colour(p), 1.0, false, false)
+                    }
+                    _ => T::ONE * pattern.scalar(p),
+                }
+            }
+            Texture::Dots {
+                mapping,
+                inside,
+                outside,
+            } => {
+                if in_dot(mapping.map(si)) {
+                    inside.eval(si)
+                } else {
+                    outside.eval(si)
+                }
             }
         }
     }
@@ -512,10 +555,11 @@ pub fn float_value(params: &ParamList, name: &str) -> Result<Option<f32>> {
     }
 }
 
-/// The texture classes pbrt-v3 has that acr does not implement.
-const UNSUPPORTED_CLASSES: [&str; 6] = ["fbm", "wrinkled", "windy", "marble", "dots", "ptex"];
+/// The texture classes pbrt-v3 has that acr does not implement (pbrt-v3 builds `ptex` only
+/// with the Ptex library).
+const UNSUPPORTED_CLASSES: [&str; 1] = ["ptex"];
 /// The texture classes acr implements.
-const CLASSES: [&str; 7] = [
+const CLASSES: [&str; 12] = [
     "constant",
     "scale",
     "mix",
@@ -523,7 +567,52 @@ const CLASSES: [&str; 7] = [
     "imagemap",
     "bilerp",
     "uv",
+    "fbm",
+    "wrinkled",
+    "windy",
+    "marble",
+    "dots",
 ];
+
+/// The pattern of a 3D noise texture class from its parameters, with pbrt-v3's defaults.
+fn noise_pattern(kind: &str, p: &ParamList) -> Result<NoisePattern> {
+    let octaves = || -> Result<u32> {
+        let v = p.int_or("octaves", 8)?;
+        if !(0..=64).contains(&v) {
+            let loc = &p.get("octaves").expect("given").loc;
+            return Err(Error::at(
+                loc,
+                format!("octaves {v} is out of range (0 to 64)"),
+            ));
+        }
+        Ok(v as u32)
+    };
+    let float = |name: &str, default: f64| -> Result<f32> {
+        let v = p.float_or(name, default)?;
+        if !v.is_finite() {
+            let loc = &p.get(name).expect("given").loc;
+            return Err(Error::at(loc, format!("{name} must be finite")));
+        }
+        Ok(v as f32)
+    };
+    Ok(match kind {
+        "fbm" => NoisePattern::Fbm {
+            omega: float("roughness", 0.5)?,
+            octaves: octaves()?,
+        },
+        "wrinkled" => NoisePattern::Wrinkled {
+            omega: float("roughness", 0.5)?,
+            octaves: octaves()?,
+        },
+        "windy" => NoisePattern::Windy,
+        _ => NoisePattern::Marble {
+            omega: float("roughness", 0.5)?,
+            octaves: octaves()?,
+            scale: float("scale", 1.0)?,
+            variation: float("variation", 0.2)?,
+        },
+    })
+}
 
 /// What identifies a converted image map (pbrt-v3's `TexInfo`, less the filtering options).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -888,11 +977,44 @@ impl<'a> TextureBuilder<'a> {
                     "the \"uv\" texture is a spectrum texture; pbrt-v3 has no float one",
                 ))
             }
+            "fbm" | "wrinkled" | "windy" | "marble" => {
+                let kind = td.plugin.kind.as_str();
+                if kind == "marble" && T::kind() != TextureValue::Spectrum {
+                    return Err(Error::at(
+                        loc,
+                        "the \"marble\" texture is a spectrum texture; pbrt-v3 has no float one",
+                    ));
+                }
+                let inv = (self.render_from_world * td.world_from_texture).inverse();
+                Texture::Noise {
+                    texture_from_render: if inv.is_finite() {
+                        inv.as_mat4()
+                    } else {
+                        Mat4::IDENTITY
+                    },
+                    pattern: noise_pattern(kind, p)?,
+                }
+            }
+            // pbrt-v3 hands its "inside" parameter to the texture's outside and "outside" to
+            // its dots (`CreateDotsFloatTexture` against the constructor's order): the images
+            // people have show it so, and so does acr.
+            "dots" => Texture::Dots {
+                mapping: Mapping2D::from_params(
+                    p,
+                    &(self.render_from_world * td.world_from_texture),
+                    loc,
+                )?,
+                inside: self.param_or(p, "outside", T::ZERO)?,
+                outside: self.param_or(p, "inside", T::ONE)?,
+            },
             other if UNSUPPORTED_CLASSES.contains(&other) => {
                 self.warn_once(
                     format!("texture class {other}"),
                     loc,
-                    format!("texture class \"{other}\" is not supported; a constant 0.5 is used"),
+                    format!(
+                        "texture class \"{other}\" is not supported (acr, like a pbrt-v3 built \
+                         without the Ptex library, has no Ptex reader); a constant 0.5 is used"
+                    ),
                 );
                 Texture::Constant(T::ONE * 0.5)
             }
@@ -1287,7 +1409,7 @@ mod tests {
     #[test]
     fn unsupported_and_unknown_classes() {
         let desc = scene(
-            r#"Texture "a" "float" "fbm"
+            r#"Texture "a" "float" "ptex"
                Texture "b" "float" "checkerbord"
                Texture "c" "float" "bilerp" "float v00" 1 "float v01" 2 "float v10" 3 "float v11" 4"#,
             Path::new("/tmp"),
@@ -1301,6 +1423,33 @@ mod tests {
         let v = c.eval(&si_uv(0.5, 0.25));
         assert!((v - (0.375 + 0.25 + 1.125 + 0.5)).abs() < 1e-5, "{v}");
         assert_eq!(b.finish().len(), 1);
+    }
+
+    #[test]
+    fn procedural_classes_build_and_check_their_parameters() {
+        let desc = scene(
+            r#"Texture "f" "float" "fbm" "integer octaves" 3 "float roughness" 0.7
+               Texture "m" "float" "marble"
+               Texture "o" "float" "wrinkled" "integer octaves" -2
+               Texture "d" "spectrum" "dots" "rgb inside" [1 0 0] "rgb outside" [0 0 1]
+               Texture "s" "spectrum" "marble" "float scale" 2"#,
+            Path::new("/tmp"),
+        );
+        let mut b = TextureBuilder::new(&desc, Path::new("/tmp"));
+        let f = b.float_texture(0).unwrap();
+        let p = Vec3::new(0.3, 1.7, -2.2);
+        assert_eq!(f.eval(&si_p(p)), crate::noise::fbm(p, 0.7, 3));
+        let e = b.float_texture(1).unwrap_err();
+        assert!(e.message().contains("spectrum texture"), "{e}");
+        let e = b.float_texture(2).unwrap_err();
+        assert!(e.message().contains("octaves -2"), "{e}");
+        // pbrt-v3's order: "inside" off the dots, "outside" on them.
+        let d = b.spectrum_texture(3).unwrap();
+        let off = d.eval(&si_uv(0.0, 0.0));
+        assert_eq!(off, Spectrum::new(1.0, 0.0, 0.0));
+        let m = b.spectrum_texture(4).unwrap();
+        assert!(m.eval(&si_p(p)).is_finite());
+        assert!(b.finish().is_empty());
     }
 
     #[test]

@@ -26,6 +26,17 @@ fn every_example_scene() {
     });
 }
 
+/// The scenes of scenes/pbrt-v3 (one per pbrt-v3 feature, with pbrt-v3's renders).
+#[test]
+fn every_pbrt_v3_feature_scene() {
+    settings().bind(|| {
+        insta::glob!("../scenes/pbrt-v3", "*.pbrt", |path| {
+            let desc = parse_file(path).unwrap_or_else(|e| panic!("{e}"));
+            insta::assert_snapshot!(desc.to_text());
+        });
+    });
+}
+
 fn snapshot_of(text: &str) -> String {
     parse_str(text, Path::new("inline.pbrt"))
         .unwrap_or_else(|e| panic!("{e}"))

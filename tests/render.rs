@@ -296,6 +296,50 @@ fn agrees_with_pbrt_v3_references() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// The scenes of `scenes/pbrt-v3/` (one per pbrt-v3 feature acr added, written for acr) with
+/// pbrt-v3's own renders in `scenes/pbrt-v3/references/`: a converged one (`-ref1024`) and
+/// one at the scene's spp (`-pbrt16`), both made by pbrt-v3 (scenes/pbrt-v3/README.md says
+/// how). Scene, file stem, spp.
+const PBRT_V3_FEATURES: &[(&str, &str, u32)] =
+    &[("procedural-textures.pbrt", "procedural-textures", 16)];
+
+/// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's
+/// own at that spp, and the image means agree within 1%: the rule of
+/// [`agrees_with_pbrt_v3_references`], on scenes and references that ship with acr.
+#[test]
+fn new_features_agree_with_pbrt_v3() {
+    let dir = root().join("scenes/pbrt-v3");
+    let mut failures = Vec::new();
+    for &(scene, stem, spp) in PBRT_V3_FEATURES {
+        let desc = parse_file(&dir.join(scene)).unwrap();
+        let r = render_desc(&desc, spp, 11);
+        let read = |name: String| {
+            acr::image_io::read_image(&dir.join("references").join(name), false)
+                .unwrap()
+                .pixels
+        };
+        let reference = read(format!("{stem}-ref1024.exr"));
+        let pbrt = read(format!("{stem}-pbrt{spp}.exr"));
+        assert_eq!(reference.len(), r.pixels.len(), "{scene}");
+        let (mse, pbrt_mse) = (
+            srgb8_mse(&r.pixels, &reference),
+            srgb8_mse(&pbrt, &reference),
+        );
+        let lum = |p: &[Spectrum]| f64::from(acr::spectrum_luminance(mean(p)));
+        let ratio = lum(&r.pixels) / lum(&reference);
+        eprintln!(
+            "{scene}: acr MSE {mse:.3e}, pbrt-v3 {pbrt_mse:.3e} (ratio {:.2}); mean {ratio:.4}",
+            mse / pbrt_mse
+        );
+        if mse > 1.25 * pbrt_mse || (ratio - 1.0).abs() > 0.01 {
+            failures.push(format!(
+                "{scene}: MSE {mse:.3e} against pbrt-v3's {pbrt_mse:.3e}, mean ratio {ratio:.4}"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 /// The public pbrt-v3 scenes without a reference render: at reduced resolution and 2 spp they
 /// build and render with no sample dropped and a lit, finite image.
 #[test]
