@@ -96,6 +96,15 @@ pub struct SurfaceInteraction {
     pub shading_n: Vec3,
     /// Shading dp/du (the tangent the BSDF frame is aligned with).
     pub shading_dpdu: Vec3,
+    /// Shading dp/dv (pbrt-v3's `shading.dpdv`: dpdv, or for a mesh with vertex normals the
+    /// unit tangent `ns x ss`), which bump mapping perturbs with `shading_dpdu`.
+    pub shading_dpdv: Vec3,
+    /// dn/du, the normal's derivative (pbrt-v3's Weingarten equations on the quadrics; zero on
+    /// triangles, where pbrt-v3 differentiates the vertex normals), which bump mapping adds
+    /// times the displacement; the same for the shading normal.
+    pub dndu: Vec3,
+    /// dn/dv.
+    pub dndv: Vec3,
     /// Unit direction towards where the ray came from (-ray.d normalised).
     pub wo: Vec3,
     /// The ray's time.

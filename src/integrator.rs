@@ -308,7 +308,9 @@ fn path_li(
         if depth >= max_depth {
             break;
         }
-        let bsdf = scene.materials[material as usize].bsdf(&si);
+        let material = &scene.materials[material as usize];
+        let si = material.shading(&si);
+        let bsdf = material.bsdf(&si);
         probe.surface(&si, &bsdf);
         prev_ctx = None;
         if have_lights && bsdf.has_non_specular() {
@@ -431,7 +433,9 @@ fn direct_li(
     let Some(material) = hit.surface.material else {
         return l;
     };
-    let bsdf = scene.materials[material as usize].bsdf(&si);
+    let material = &scene.materials[material as usize];
+    let si = material.shading(&si);
+    let bsdf = material.bsdf(&si);
     tally.probe.surface(&si, &bsdf);
     if bsdf.has_non_specular() && !scene.lights.is_empty() {
         match strategy {

@@ -5,6 +5,7 @@ pub mod accel;
 pub mod aov;
 pub mod bench;
 pub mod bsdf;
+pub mod bump;
 pub mod camera;
 pub mod cli;
 pub mod features;

@@ -3,8 +3,9 @@
 //! `ComputeScatteringFunctions` does (radiance transport, several lobes allowed as the path
 //! integrator asks).
 //!
-//! Not supported: bump mapping (`bumpmap` is ignored with a warning), per-shape overrides of
-//! material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like), and the translucent,
+//! Bump mapping (`bumpmap` on every material) is [`crate::bump`]'s. Not supported: per-shape
+//! overrides of material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like), and the
+//! translucent,
 //! hair, subsurface, kdsubsurface, fourier and disney materials (replaced by a matte with the
 //! material's `Kd`, with a warning).
 
@@ -45,7 +46,7 @@ const UNSUPPORTED_KINDS: [&str; 6] = [
 /// Types that make no surface: rays pass through.
 const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
 /// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
-const UNSUPPORTED_PARAMS: [&str; 3] = ["bumpmap", "displacement", "normalmap"];
+const UNSUPPORTED_PARAMS: [&str; 2] = ["displacement", "normalmap"];
 
 /// A surface's material, its parameters possibly textured.
 // Materials are built once and kept in one Vec; boxing the large variants would add a pointer
@@ -150,6 +151,14 @@ pub enum Material {
         /// `namedmaterial1` and `namedmaterial2`.
         materials: [Arc<Material>; 2],
     },
+    /// A material with a `bumpmap`: its shading geometry bumped by the displacement texture
+    /// ([`Material::shading`]), its lobes the inner material's.
+    Bumped {
+        /// The displacement.
+        map: Arc<FloatTexture>,
+        /// The material bumped.
+        inner: Arc<Material>,
+    },
     /// No surface (`"none"`, `"interface"`): an empty BSDF. A renderer should let rays pass
     /// through shapes with this material, as pbrt-v3 does for `Material ""`.
     Interface,
@@ -188,6 +197,19 @@ impl Material {
     /// Whether the material makes no surface (rays should pass through).
     pub fn is_interface(&self) -> bool {
         matches!(self, Material::Interface)
+    }
+
+    /// The hit as this material shades it: with its shading geometry bumped when the material
+    /// has a `bumpmap` (pbrt-v3's `Material::Bump`, called first in every material's
+    /// `ComputeScatteringFunctions`); a mix takes its first material's, as pbrt-v3's mix
+    /// builds its BSDF in the frame its first material left. Integrators shade and take
+    /// cosines with the result.
+    pub fn shading(&self, si: &SurfaceInteraction) -> SurfaceInteraction {
+        match self {
+            Material::Bumped { map, .. } => crate::bump::bump(map, si),
+            Material::Mix { materials, .. } => materials[0].shading(si),
+            _ => *si,
+        }
     }
 
     /// The BSDF at a hit (several lobes allowed, as pbrt-v3's path integrators ask: a smooth
@@ -468,6 +490,9 @@ impl Material {
                 materials[0].add_lobes(si, allow_multiple_lobes, b, s1 * scale, first);
                 materials[1].add_lobes(si, allow_multiple_lobes, b, s2 * scale, false);
             }
+            Material::Bumped { inner, .. } => {
+                inner.add_lobes(si, allow_multiple_lobes, b, scale, first)
+            }
             Material::Interface => {}
         }
     }
@@ -494,7 +519,16 @@ impl<'a> MaterialBuilder<'a> {
             ));
         }
         self.in_progress[index] = true;
-        let m = Arc::new(self.make(md)?);
+        let mut m = Arc::new(self.make(md)?);
+        let p = &md.plugin.params;
+        if !m.is_interface() {
+            if let Some(map) = self.textures.float_param_opt(p, "bumpmap")? {
+                m = Arc::new(Material::Bumped {
+                    map: Arc::new(map),
+                    inner: m,
+                });
+            }
+        }
         self.in_progress[index] = false;
         self.built[index] = Some(Arc::clone(&m));
         Ok(m)
@@ -691,6 +725,9 @@ mod tests {
             dpdv: Vec3::Y,
             shading_n: Vec3::Z,
             shading_dpdu: Vec3::X,
+            shading_dpdv: Vec3::Y,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
             wo: Vec3::Z,
             time: 0.0,
         }
@@ -961,15 +998,18 @@ mod tests {
 
     #[test]
     fn unsupported_parameters_warn_once_and_unknown_types_fail() {
-        let (_, w) = build(&format!(
+        let (m, w) = build(&format!(
             r#"Texture "bump" "float" "constant"
-               Material "matte" "texture bumpmap" "bump"
+               Material "matte" "texture bumpmap" "bump" "texture normalmap" "bump"
                {SHAPE}
-               Material "plastic" "texture bumpmap" "bump"
+               Material "plastic" "texture bumpmap" "bump" "texture normalmap" "bump"
                {SHAPE}"#
         ));
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(w[0].message.contains("bumpmap") && w[0].loc.is_some());
+        assert!(w[0].message.contains("normalmap") && w[0].loc.is_some());
+        // bumpmap is built (issue 27): every material carries it.
+        let bumped = m.iter().filter(|m| matches!(m, Material::Bumped { .. }));
+        assert_eq!(bumped.count(), 2, "{m:?}");
 
         let e = build_err(&format!("Material \"platic\"\n{SHAPE}"));
         assert!(e.message().contains("unknown material \"platic\""), "{e}");

@@ -854,6 +854,20 @@ impl<'a> TextureBuilder<'a> {
         ))
     }
 
+    /// The 3D textures' mapping from render space, as pbrt-v3 builds it: its
+    /// `IdentityMapping3D(tex2world)` takes the texture's transform as the world-to-texture
+    /// one, so the texture's CTM is applied to the world point, not its inverse (`Scale 0.5`
+    /// before a `Texture` makes a 3D pattern twice as coarse, where a 2D mapping's would be
+    /// twice as fine). Kept, so that images match.
+    fn texture_from_render_3d(&self, world_from_texture: DMat4) -> Mat4 {
+        let m = world_from_texture * self.render_from_world.inverse();
+        if m.is_finite() {
+            m.as_mat4()
+        } else {
+            Mat4::IDENTITY
+        }
+    }
+
     fn texture<T: Build>(&mut self, index: usize) -> Result<Arc<Texture<T>>> {
         if let Some(t) = T::cache(self).get(index).cloned().flatten() {
             return Ok(t);
@@ -918,18 +932,11 @@ impl<'a> TextureBuilder<'a> {
                             tex2,
                         }
                     }
-                    3 => {
-                        let inv = (self.render_from_world * td.world_from_texture).inverse();
-                        Texture::Checkerboard3D {
-                            texture_from_world: if inv.is_finite() {
-                                inv.as_mat4()
-                            } else {
-                                Mat4::IDENTITY
-                            },
-                            tex1,
-                            tex2,
-                        }
-                    }
+                    3 => Texture::Checkerboard3D {
+                        texture_from_world: self.texture_from_render_3d(td.world_from_texture),
+                        tex1,
+                        tex2,
+                    },
                     d => {
                         let at = p.get("dimension").map_or(loc, |x| &x.loc);
                         return Err(Error::at(
@@ -985,13 +992,8 @@ impl<'a> TextureBuilder<'a> {
                         "the \"marble\" texture is a spectrum texture; pbrt-v3 has no float one",
                     ));
                 }
-                let inv = (self.render_from_world * td.world_from_texture).inverse();
                 Texture::Noise {
-                    texture_from_render: if inv.is_finite() {
-                        inv.as_mat4()
-                    } else {
-                        Mat4::IDENTITY
-                    },
+                    texture_from_render: self.texture_from_render_3d(td.world_from_texture),
                     pattern: noise_pattern(kind, p)?,
                 }
             }
@@ -1116,6 +1118,9 @@ mod tests {
             dpdv: Vec3::Y,
             shading_n: Vec3::Z,
             shading_dpdu: Vec3::X,
+            shading_dpdv: Vec3::Y,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
             wo: Vec3::Z,
             time: 0.0,
         }

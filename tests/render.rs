@@ -300,8 +300,10 @@ fn agrees_with_pbrt_v3_references() {
 /// pbrt-v3's own renders in `scenes/pbrt-v3/references/`: a converged one (`-ref1024`) and
 /// one at the scene's spp (`-pbrt16`), both made by pbrt-v3 (scenes/pbrt-v3/README.md says
 /// how). Scene, file stem, spp.
-const PBRT_V3_FEATURES: &[(&str, &str, u32)] =
-    &[("procedural-textures.pbrt", "procedural-textures", 16)];
+const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
+    ("procedural-textures.pbrt", "procedural-textures", 16),
+    ("bump-map.pbrt", "bump-map", 16),
+];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's
 /// own at that spp, and the image means agree within 1%: the rule of

@@ -306,6 +306,9 @@ fn unreachable_interaction(ray: &Ray, t: f32) -> SurfaceInteraction {
         dpdv: Vec3::Y,
         shading_n: n,
         shading_dpdu: Vec3::X,
+        shading_dpdv: Vec3::Y,
+        dndu: Vec3::ZERO,
+        dndv: Vec3::ZERO,
         wo: n,
         time: ray.time,
     }
@@ -528,6 +531,10 @@ fn transform_interaction(
         dpdv: to_world.transform_vector3(si.dpdv),
         shading_n: normal(si.shading_n),
         shading_dpdu: to_world.transform_vector3(si.shading_dpdu),
+        shading_dpdv: to_world.transform_vector3(si.shading_dpdv),
+        // Derivatives of the normal: transformed as normals, not normalised.
+        dndu: to_local.transpose().transform_vector3(si.dndu),
+        dndv: to_local.transpose().transform_vector3(si.dndv),
         wo: -world_ray.d.normalize(),
         time: si.time,
     }

@@ -155,6 +155,8 @@ impl Cylinder {
         let v = (p.z - self.z_min) / (self.z_max - self.z_min);
         let dpdu = Vec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0);
         let dpdv = Vec3::new(0.0, 0.0, self.z_max - self.z_min);
+        let pm = self.phi_max;
+        let second = [-pm * pm * Vec3::new(p.x, p.y, 0.0), Vec3::ZERO, Vec3::ZERO];
         quadric_interaction(
             &self.object_to_world,
             self.flip,
@@ -163,6 +165,7 @@ impl Cylinder {
             Vec2::new(u, v),
             dpdu,
             dpdv,
+            Some(second),
         )
     }
 

@@ -132,6 +132,8 @@ impl Disk {
             Vec2::new(u, v),
             dpdu,
             dpdv,
+            // A plane: pbrt-v3's dn/du = dn/dv = 0.
+            None,
         )
     }
 

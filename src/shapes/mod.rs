@@ -239,6 +239,7 @@ pub(crate) fn phi_of(p: Vec3) -> f32 {
 /// then everything is carried to world space (the normal by the inverse transpose). The shading
 /// geometry is the geometric one.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn quadric_interaction(
     to_world: &Transform,
     flip: bool,
@@ -247,8 +248,10 @@ pub(crate) fn quadric_interaction(
     uv: Vec2,
     dpdu: Vec3,
     dpdv: Vec3,
+    second: Option<[Vec3; 3]>,
 ) -> SurfaceInteraction {
     let n_obj = dpdu.cross(dpdv).normalize_or(Vec3::Z);
+    let (dndu, dndv) = second.map_or((Vec3::ZERO, Vec3::ZERO), |d2| weingarten(dpdu, dpdv, d2));
     let n_obj = if flip { -n_obj } else { n_obj };
     let n = to_world.normal(n_obj).normalize_or(n_obj);
     let dpdu_w = to_world.vector(dpdu);
@@ -260,9 +263,30 @@ pub(crate) fn quadric_interaction(
         dpdv: to_world.vector(dpdv),
         shading_n: n,
         shading_dpdu: dpdu_w,
+        shading_dpdv: to_world.vector(dpdv),
+        dndu: to_world.normal(dndu),
+        dndv: to_world.normal(dndv),
         wo: (-ray.d).normalize_or_zero(),
         time: ray.time,
     }
+}
+
+/// dn/du and dn/dv of the unit normal normalize(dpdu x dpdv) from the surface's first and
+/// second derivatives (`second` = d2p/du2, d2p/dudv, d2p/dv2): pbrt-v3's Weingarten equations,
+/// shared by the quadrics. Zero where the first fundamental form is singular.
+pub(crate) fn weingarten(dpdu: Vec3, dpdv: Vec3, second: [Vec3; 3]) -> (Vec3, Vec3) {
+    let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
+    let n = dpdu.cross(dpdv).normalize_or_zero();
+    let [duu, duv, dvv] = second;
+    let (e2, f2, g2) = (n.dot(duu), n.dot(duv), n.dot(dvv));
+    let det = e1 * g1 - f1 * f1;
+    if det.abs() < f32::MIN_POSITIVE || !det.is_finite() {
+        return (Vec3::ZERO, Vec3::ZERO);
+    }
+    let inv = 1.0 / det;
+    let dndu = (f2 * f1 - e2 * g1) * inv * dpdu + (e2 * f1 - f2 * e1) * inv * dpdv;
+    let dndv = (g2 * f1 - f2 * g1) * inv * dpdu + (f2 * f1 - g2 * e1) * inv * dpdv;
+    (dndu, dndv)
 }
 
 /// The world-space area of a quadric of object-space area `object_area` placed by `t`: exact
@@ -388,5 +412,37 @@ mod tests {
         let (t0, t1) = quadratic_roots(a, b, c, b * b - 4.0 * a * c).unwrap();
         assert!((t1 + 1e-8).abs() < 1e-20 && (t0 + 1e8).abs() < 1.0);
         assert!(quadratic_roots(1.0, 0.0, 1.0, -4.0).is_none());
+    }
+}
+
+#[cfg(test)]
+mod weingarten_tests {
+    use super::*;
+
+    #[test]
+    fn a_sphere_s_normal_turns_as_its_point_over_the_radius() {
+        // pbrt-v3's full sphere of radius r at phi, theta (theta runs from thetaZMin = pi at
+        // z = -r to thetaZMax = 0: dtheta = -pi): dn/du = dp/du / r, the outward normal's.
+        let (r, phi, theta) = (0.9f32, 0.7f32, 1.1f32);
+        let pm = std::f32::consts::TAU;
+        let dt = -std::f32::consts::PI;
+        let p = r * Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        let dpdu = Vec3::new(-pm * p.y, pm * p.x, 0.0);
+        let dpdv = dt * Vec3::new(p.z * phi.cos(), p.z * phi.sin(), -r * theta.sin());
+        let second = [
+            -pm * pm * Vec3::new(p.x, p.y, 0.0),
+            dt * p.z * pm * Vec3::new(-phi.sin(), phi.cos(), 0.0),
+            -dt * dt * p,
+        ];
+        let (dndu, dndv) = weingarten(dpdu, dpdv, second);
+        assert!((dndu - dpdu / r).length() < 1e-4, "{dndu} {}", dpdu / r);
+        assert!((dndv - dpdv / r).length() < 1e-4, "{dndv} {}", dpdv / r);
+        // A plane's normal does not turn.
+        let flat = weingarten(Vec3::X, Vec3::Y, [Vec3::ZERO; 3]);
+        assert_eq!(flat, (Vec3::ZERO, Vec3::ZERO));
     }
 }

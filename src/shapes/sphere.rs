@@ -190,6 +190,12 @@ impl Sphere {
         let sin_phi = p.y / z_radius;
         let dpdu = Vec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0);
         let dpdv = dtheta * Vec3::new(p.z * cos_phi, p.z * sin_phi, -self.radius * theta.sin());
+        let pm = self.phi_max;
+        let second = [
+            -pm * pm * Vec3::new(p.x, p.y, 0.0),
+            dtheta * p.z * pm * Vec3::new(-sin_phi, cos_phi, 0.0),
+            -dtheta * dtheta * p,
+        ];
         quadric_interaction(
             &self.object_to_world,
             self.flip,
@@ -198,6 +204,7 @@ impl Sphere {
             Vec2::new(u, v),
             dpdu,
             dpdv,
+            Some(second),
         )
     }
 

@@ -370,7 +370,7 @@ pub fn triangle_interaction(
     let uv_hit = b0 * uv[0] + b1 * uv[1] + b2 * uv[2];
     let mut n = (p[0] - p[2]).cross(p[1] - p[2]).normalize();
 
-    let (shading_n, shading_dpdu) = if mesh.normals.is_some() {
+    let (shading_n, shading_dpdu, shading_dpdv) = if mesh.normals.is_some() {
         let ns = shading_normal(mesh, tri, [b0, b1, b2]).unwrap_or(n);
         let mut ss = dpdu.normalize();
         let mut ts = ss.cross(ns);
@@ -383,12 +383,12 @@ pub fn triangle_interaction(
         // SetShadingGeometry(ss, ts, .., orientationIsAuthoritative = true).
         let sn = ss.cross(ts).normalize();
         n = faceforward(n, sn);
-        (sn, ss)
+        (sn, ss, ts)
     } else {
         if mesh.reverse_orientation ^ mesh.transform_swaps_handedness {
             n = -n;
         }
-        (n, dpdu)
+        (n, dpdu, dpdv)
     };
 
     SurfaceInteraction {
@@ -399,6 +399,9 @@ pub fn triangle_interaction(
         dpdv,
         shading_n,
         shading_dpdu,
+        shading_dpdv,
+        dndu: Vec3::ZERO,
+        dndv: Vec3::ZERO,
         wo: (-ray.d).normalize_or_zero(),
         time: ray.time,
     }
