@@ -1,5 +1,7 @@
-//! pbrt-v3's perspective camera: field of view on the shorter image axis, screen window, thin
-//! lens, shutter interval, and a camera transform that may move.
+//! pbrt-v3's cameras: `perspective` (field of view on the shorter image axis, screen window,
+//! thin lens), `orthographic` (screen window, thin lens) and `environment` (the whole sphere
+//! in latitude-longitude), with a shutter interval and a camera transform that may move.
+//! pbrt-v3's `realistic` (a lens system read from a file) is refused with a located error.
 
 use crate::geometry::{Ray, Vec2, Vec3};
 use crate::sampling::concentric_sample_disk;
@@ -18,9 +20,24 @@ pub struct CameraSample {
     pub time: f32,
 }
 
-/// A perspective camera.
+/// How a camera turns film positions into rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Projection {
+    /// Rays from the origin through the film (pbrt-v3's `perspective`).
+    Perspective,
+    /// Parallel rays along +z from the film (pbrt-v3's `orthographic`).
+    Orthographic,
+    /// Every direction: x is the longitude, y the latitude (pbrt-v3's `environment`).
+    Environment,
+}
+
+/// A camera.
 #[derive(Clone, Debug)]
 pub struct Camera {
+    /// The projection.
+    pub projection: Projection,
+    /// The film's full resolution (the environment camera's angles are fractions of it).
+    resolution: (f32, f32),
     raster_to_camera: Mat4,
     world_from_camera: MotionTransform,
     /// Thin-lens radius; 0 for a pinhole.
@@ -42,15 +59,28 @@ impl Camera {
         render_from_world: glam::DMat4,
     ) -> Result<Self> {
         let p = &desc.plugin;
-        if p.kind != "perspective" {
-            return Err(Error::at(
-                &p.loc,
-                format!(
-                    "camera \"{}\" is not supported (only \"perspective\")",
-                    p.kind
-                ),
-            ));
-        }
+        let projection = match p.kind.as_str() {
+            "perspective" => Projection::Perspective,
+            "orthographic" => Projection::Orthographic,
+            "environment" => Projection::Environment,
+            "realistic" => {
+                return Err(Error::at(
+                    &p.loc,
+                    "camera \"realistic\" (pbrt-v3's lens-system camera) is not supported; \
+                     \"perspective\" with \"lensradius\" and \"focaldistance\" gives a thin \
+                     lens",
+                ))
+            }
+            other => {
+                return Err(Error::at(
+                    &p.loc,
+                    format!(
+                        "camera \"{other}\" is not supported (perspective, orthographic, \
+                         environment)"
+                    ),
+                ))
+            }
+        };
         let params = &p.params;
         let (xres, yres) = (resolution.0 as f32, resolution.1 as f32);
         let frame = params.float_or("frameaspectratio", (xres / yres) as f64)? as f32;
@@ -78,7 +108,12 @@ impl Camera {
                 format!("fov {fov} is not between 0 and 180 degrees"),
             ));
         }
-        let lens_radius = params.float_or("lensradius", 0.0)? as f32;
+        // The environment camera has no lens (pbrt-v3 reads no lens parameters for it).
+        let lens_radius = if projection == Projection::Environment {
+            0.0
+        } else {
+            params.float_or("lensradius", 0.0)? as f32
+        };
         let focal_distance = params.float_or("focaldistance", 1e6)? as f32;
         let shutter_open = params.float_or("shutteropen", 0.0)? as f32;
         let shutter_close = params.float_or("shutterclose", 1.0)? as f32;
@@ -89,8 +124,12 @@ impl Camera {
             ));
         }
 
-        // pbrt-v3: camera -> screen (Perspective), screen -> raster.
-        let camera_to_screen = perspective(fov, 1e-2, 1000.0);
+        // pbrt-v3: camera -> screen (Perspective, or Orthographic(0, 1): the identity here),
+        // screen -> raster.
+        let camera_to_screen = match projection {
+            Projection::Perspective => perspective(fov, 1e-2, 1000.0),
+            _ => Mat4::IDENTITY,
+        };
         let screen_to_raster = Mat4::from_scale(Vec3::new(xres, yres, 1.0))
             * Mat4::from_scale(Vec3::new(
                 1.0 / (screen[1] - screen[0]),
@@ -105,6 +144,8 @@ impl Camera {
             ..desc.camera_from_world
         };
         Ok(Self {
+            projection,
+            resolution: (xres, yres),
             raster_to_camera,
             world_from_camera: MotionTransform::new(&inverse_motion),
             lens_radius,
@@ -128,12 +169,26 @@ impl Camera {
     pub fn generate_ray(&self, s: &CameraSample) -> Ray {
         let p = self.raster_to_camera * Vec4::new(s.film.x, s.film.y, 0.0, 1.0);
         let p_camera = p.truncate() / p.w;
-        let mut o = Vec3::ZERO;
-        let mut d = p_camera.normalize();
+        let (mut o, mut d) = match self.projection {
+            Projection::Perspective => (Vec3::ZERO, p_camera.normalize()),
+            Projection::Orthographic => (p_camera, Vec3::Z),
+            Projection::Environment => {
+                let theta = std::f32::consts::PI * s.film.y / self.resolution.1;
+                let phi = 2.0 * std::f32::consts::PI * s.film.x / self.resolution.0;
+                let d = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
+                (Vec3::ZERO, d)
+            }
+        };
         if self.lens_radius > 0.0 {
             let lens = self.lens_radius * concentric_sample_disk(s.lens);
             let ft = self.focal_distance / d.z;
-            let focus = d * ft;
+            let focus = o + d * ft;
+            // pbrt-v3's orthographic camera, too, puts the lens point at (lens.x, lens.y, 0),
+            // not beside the film point: kept, so that images match.
             o = Vec3::new(lens.x, lens.y, 0.0);
             d = (focus - o).normalize();
         }
@@ -219,5 +274,59 @@ mod tests {
         }
         assert!((points[0] - points[1]).length() < 1e-4);
         assert!((points[0] - points[2]).length() < 1e-4);
+    }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_span_the_screen_window() {
+        let c = camera(
+            "LookAt 0 0 5 0 0 0 0 1 0 Camera \"orthographic\" \"float screenwindow\" [-2 2 -1 1]",
+            (100, 50),
+        );
+        let at = |x: f32, y: f32| {
+            c.generate_ray(&CameraSample {
+                film: Vec2::new(x, y),
+                ..Default::default()
+            })
+        };
+        for r in [at(0.0, 0.0), at(50.0, 25.0), at(100.0, 50.0)] {
+            assert!((r.d - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6, "{}", r.d);
+        }
+        // The film's corners are the screen window's: raster (0, 0) is camera (-2, 1), which
+        // pbrt's left-handed camera space puts at world (2, 1, 5).
+        assert!((at(0.0, 0.0).o - Vec3::new(2.0, 1.0, 5.0)).length() < 1e-5);
+        assert!((at(100.0, 50.0).o - Vec3::new(-2.0, -1.0, 5.0)).length() < 1e-5);
+    }
+
+    #[test]
+    fn the_environment_camera_sees_every_direction() {
+        let c = camera("Camera \"environment\"", (200, 100));
+        let at = |x: f32, y: f32| {
+            c.generate_ray(&CameraSample {
+                film: Vec2::new(x, y),
+                ..Default::default()
+            })
+            .d
+        };
+        // pbrt-v3's (sin t cos p, cos t, sin t sin p), t = pi y / height, p = 2 pi x / width.
+        assert!((at(0.0, 0.0) - Vec3::Y).length() < 1e-6);
+        assert!((at(0.0, 50.0) - Vec3::X).length() < 1e-6);
+        assert!((at(50.0, 50.0) - Vec3::Z).length() < 1e-5);
+        assert!((at(100.0, 50.0) + Vec3::X).length() < 1e-5);
+        assert!((at(10.0, 100.0) + Vec3::Y).length() < 1e-5);
+        for (x, y) in [(13.0, 7.0), (150.0, 80.0)] {
+            assert!((at(x, y).length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn realistic_and_unknown_cameras_are_located_errors() {
+        for (kind, says) in [("realistic", "lens-system"), ("fisheye", "not supported")] {
+            let d =
+                acr_parser::parse_str(&format!("Camera \"{kind}\""), Path::new("c.pbrt")).unwrap();
+            let e =
+                Camera::new(d.camera.as_ref().unwrap(), (8, 8), glam::DMat4::IDENTITY).unwrap_err();
+            assert!(e.to_string().contains(says), "{e}");
+            assert!(e.to_string().contains("c.pbrt:1:1"), "{e}");
+        }
     }
 }
