@@ -157,14 +157,7 @@ struct LightChoices {
 }
 
 /// Shape types pbrt-v3 has and acr does not: warned about once and skipped.
-const UNSUPPORTED_SHAPES: &[&str] = &[
-    "curve",
-    "nurbs",
-    "heightfield",
-    "cone",
-    "paraboloid",
-    "hyperboloid",
-];
+const UNSUPPORTED_SHAPES: &[&str] = &["curve", "nurbs", "cone", "paraboloid", "hyperboloid"];
 
 /// Builds scenes, collecting warnings.
 struct Builder<'a> {
@@ -301,6 +294,11 @@ impl Builder<'_> {
             "loopsubdiv" => {
                 let mesh =
                     crate::shapes::loopsubdiv::mesh_from_params(params, &p.loc, self.warnings)?;
+                let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
+                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
+            }
+            "heightfield" => {
+                let mesh = crate::shapes::heightfield::mesh_from_params(params, &p.loc)?;
                 let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
                 self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
             }

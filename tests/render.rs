@@ -305,6 +305,7 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("bump-map.pbrt", "bump-map", 16),
     ("orthographic-camera.pbrt", "orthographic-camera", 16),
     ("environment-camera.pbrt", "environment-camera", 16),
+    ("heightfield.pbrt", "heightfield", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

@@ -5,6 +5,7 @@
 
 pub mod cylinder;
 pub mod disk;
+pub mod heightfield;
 pub mod loopsubdiv;
 pub mod sphere;
 pub mod triangle;
