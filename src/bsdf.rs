@@ -175,6 +175,11 @@ pub enum Bxdf {
         /// Reflectance.
         r: Spectrum,
     },
+    /// Lambertian transmission: T / π to the other side (pbrt-v3's, for `translucent`).
+    LambertianTransmission {
+        /// Transmittance.
+        t: Spectrum,
+    },
     /// Oren-Nayar rough diffuse reflection.
     OrenNayar {
         /// Reflectance.
@@ -260,6 +265,7 @@ impl Bxdf {
         use BxdfType as T;
         match self {
             Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } => T::REFLECTION.or(T::DIFFUSE),
+            Bxdf::LambertianTransmission { .. } => T::TRANSMISSION.or(T::DIFFUSE),
             Bxdf::SpecularReflection { .. } => T::REFLECTION.or(T::SPECULAR),
             Bxdf::SpecularTransmission { .. } => T::TRANSMISSION.or(T::SPECULAR),
             Bxdf::FresnelSpecular { .. } => T::REFLECTION.or(T::TRANSMISSION).or(T::SPECULAR),
@@ -280,6 +286,8 @@ impl Bxdf {
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Spectrum {
         match *self {
             Bxdf::Lambertian { r } => r * FRAC_1_PI,
+            // As pbrt-v3, whatever the sides: the BSDF's geometric test keeps transmission.
+            Bxdf::LambertianTransmission { t } => t * FRAC_1_PI,
             Bxdf::OrenNayar { r, a, b } => {
                 let sin_i = sin_theta(wi);
                 let sin_o = sin_theta(wo);
@@ -407,6 +415,18 @@ impl Bxdf {
             Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } => {
                 let mut wi = cosine_sample_hemisphere(u);
                 if wo.z < 0.0 {
+                    wi.z = -wi.z;
+                }
+                LobeSample {
+                    wi,
+                    f: self.f(wo, wi),
+                    pdf: self.pdf(wo, wi),
+                    kind,
+                }
+            }
+            Bxdf::LambertianTransmission { .. } => {
+                let mut wi = cosine_sample_hemisphere(u);
+                if wo.z > 0.0 {
                     wi.z = -wi.z;
                 }
                 LobeSample {
@@ -570,6 +590,13 @@ impl Bxdf {
                     abs_cos_theta(wi) * FRAC_1_PI
                 } else {
                     0.0
+                }
+            }
+            Bxdf::LambertianTransmission { .. } => {
+                if same_hemisphere(wo, wi) {
+                    0.0
+                } else {
+                    abs_cos_theta(wi) * FRAC_1_PI
                 }
             }
             Bxdf::SpecularReflection { .. }
@@ -757,6 +784,7 @@ impl Bsdf {
                     | Bxdf::SpecularReflection { r, .. }
                     | Bxdf::MicrofacetReflection { r, .. } => r,
                     Bxdf::SpecularTransmission { t, .. }
+                    | Bxdf::LambertianTransmission { t }
                     | Bxdf::MicrofacetTransmission { t, .. } => t,
                     Bxdf::FresnelSpecular { r, t, .. } => r.max(t),
                     Bxdf::FresnelBlend { rd, rs, .. } => rd + rs,
@@ -1089,6 +1117,10 @@ mod tests {
                     rs: Spectrum::splat(0.04),
                     distribution: ggx(0.25, 0.25),
                 },
+            ),
+            (
+                "lambertian transmission",
+                Bxdf::LambertianTransmission { t: Spectrum::ONE },
             ),
         ]
     }

@@ -1,11 +1,10 @@
-//! pbrt-v3's materials (materials/*.cpp): matte, plastic, mirror, glass, metal, uber, substrate
-//! and mix, with textured parameters, each turning a hit into a [`Bsdf`] as pbrt-v3's
+//! pbrt-v3's materials (materials/*.cpp): matte, plastic, mirror, glass, metal, uber, substrate,
+//! translucent and mix, with textured parameters, each turning a hit into a [`Bsdf`] as pbrt-v3's
 //! `ComputeScatteringFunctions` does (radiance transport, several lobes allowed as the path
 //! integrator asks).
 //!
 //! Bump mapping (`bumpmap` on every material) is [`crate::bump`]'s. Not supported: per-shape
 //! overrides of material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like), and the
-//! translucent,
 //! hair, subsurface, kdsubsurface, fourier and disney materials (replaced by a matte with the
 //! material's `Kd`, with a warning).
 
@@ -24,8 +23,9 @@ pub const COPPER_ETA: Spectrum = Spectrum::new(0.200438, 0.924033, 1.10221);
 pub const COPPER_K: Spectrum = Spectrum::new(3.91295, 2.45285, 2.14219);
 
 /// Material types acr builds.
-const KINDS: [&str; 8] = [
+const KINDS: [&str; 9] = [
     "matte",
+    "translucent",
     "plastic",
     "mirror",
     "glass",
@@ -35,14 +35,7 @@ const KINDS: [&str; 8] = [
     "mix",
 ];
 /// pbrt-v3 material types acr replaces by a matte.
-const UNSUPPORTED_KINDS: [&str; 6] = [
-    "translucent",
-    "hair",
-    "subsurface",
-    "kdsubsurface",
-    "fourier",
-    "disney",
-];
+const UNSUPPORTED_KINDS: [&str; 5] = ["hair", "subsurface", "kdsubsurface", "fourier", "disney"];
 /// Types that make no surface: rays pass through.
 const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
 /// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
@@ -140,6 +133,22 @@ pub enum Material {
         u_roughness: FloatTexture,
         /// Roughness along the bitangent.
         v_roughness: FloatTexture,
+        /// Whether roughness goes through `roughness_to_alpha`.
+        remap_roughness: bool,
+    },
+    /// pbrt-v3's `translucent`: diffuse and glossy reflection weighted by `reflect`, diffuse
+    /// and glossy transmission weighted by `transmit` (index 1.5).
+    Translucent {
+        /// Diffuse reflectance and transmittance.
+        kd: SpectrumTexture,
+        /// Glossy reflectance and transmittance.
+        ks: SpectrumTexture,
+        /// Share reflected.
+        reflect: SpectrumTexture,
+        /// Share transmitted.
+        transmit: SpectrumTexture,
+        /// Microfacet roughness.
+        roughness: FloatTexture,
         /// Whether roughness goes through `roughness_to_alpha`.
         remap_roughness: bool,
     },
@@ -483,6 +492,63 @@ impl Material {
                     );
                 }
             }
+            Material::Translucent {
+                kd,
+                ks,
+                reflect,
+                transmit,
+                roughness,
+                remap_roughness,
+            } => {
+                // pbrt-v3's TranslucentMaterial::ComputeScatteringFunctions.
+                const ETA: f32 = 1.5;
+                if first {
+                    b.set_eta(ETA);
+                }
+                let (r, t) = (clamp0(reflect.eval(si)), clamp0(transmit.eval(si)));
+                if is_black(r) && is_black(t) {
+                    return;
+                }
+                let kd = clamp0(kd.eval(si));
+                if !is_black(kd) {
+                    if !is_black(r) {
+                        b.add_scaled(Bxdf::Lambertian { r: r * kd }, scale);
+                    }
+                    if !is_black(t) {
+                        b.add_scaled(Bxdf::LambertianTransmission { t: t * kd }, scale);
+                    }
+                }
+                let ks = clamp0(ks.eval(si));
+                if !is_black(ks) {
+                    let rough = roughness.eval(si);
+                    let dist = distribution(rough, rough, *remap_roughness);
+                    if !is_black(r) {
+                        let fresnel = Fresnel::Dielectric {
+                            eta_i: 1.0,
+                            eta_t: ETA,
+                        };
+                        b.add_scaled(
+                            Bxdf::MicrofacetReflection {
+                                r: r * ks,
+                                distribution: dist,
+                                fresnel,
+                            },
+                            scale,
+                        );
+                    }
+                    if !is_black(t) {
+                        b.add_scaled(
+                            Bxdf::MicrofacetTransmission {
+                                t: t * ks,
+                                distribution: dist,
+                                eta_a: 1.0,
+                                eta_b: ETA,
+                            },
+                            scale,
+                        );
+                    }
+                }
+            }
             Material::Mix { amount, materials } => {
                 let s1 = clamp0(amount.eval(si));
                 let s2 = clamp0(Spectrum::ONE - s1);
@@ -608,6 +674,14 @@ impl<'a> MaterialBuilder<'a> {
                 ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.5))?,
                 u_roughness: t.float_param(p, "uroughness", 0.1)?,
                 v_roughness: t.float_param(p, "vroughness", 0.1)?,
+                remap_roughness: remap(p)?,
+            },
+            "translucent" => Material::Translucent {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
+                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
+                reflect: t.spectrum_param(p, "reflect", Spectrum::splat(0.5))?,
+                transmit: t.spectrum_param(p, "transmit", Spectrum::splat(0.5))?,
+                roughness: t.float_param(p, "roughness", 0.1)?,
                 remap_roughness: remap(p)?,
             },
             "mix" => {
@@ -1017,10 +1091,27 @@ mod tests {
         assert!(matches!(e, Error::At { .. }));
 
         let (m, w) = build(&format!(
-            "Material \"translucent\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
+            "Material \"hair\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
         ));
         assert_eq!(w.len(), 1);
         assert!(matches!(m.last().unwrap(), Material::Matte { .. }));
+
+        // translucent (issue 27): pbrt-v3's four lobes with its defaults, index 1.5.
+        let (m, w) = build(&format!("Material \"translucent\"\n{SHAPE}"));
+        assert!(w.is_empty(), "{w:?}");
+        let b = m.last().unwrap().bsdf(&si());
+        assert_eq!(b.num_lobes(), 4);
+        // Diffuse transmission: 0.5 x 0.25 / pi straight through, and nothing of it on the
+        // same side (the reflection lobes give that).
+        let through = b.f(Vec3::Z, -Vec3::Z);
+        let diffuse_t = 0.5 * 0.25 / std::f32::consts::PI;
+        assert!(through.x >= diffuse_t - 1e-6, "{through}");
+        let (m, _) = build(&format!(
+            "Material \"translucent\" \"rgb transmit\" [0 0 0] \"rgb Ks\" [0 0 0]\n{SHAPE}"
+        ));
+        let b = m.last().unwrap().bsdf(&si());
+        assert_eq!(b.num_lobes(), 1);
+        assert_eq!(b.f(Vec3::Z, -Vec3::Z), Spectrum::ZERO);
 
         let (m, _) = build(&format!(
             "MakeNamedMaterial \"air\" \"string type\" \"none\"\nNamedMaterial \"air\"\n{SHAPE}"

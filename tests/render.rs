@@ -306,6 +306,7 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("orthographic-camera.pbrt", "orthographic-camera", 16),
     ("environment-camera.pbrt", "environment-camera", 16),
     ("heightfield.pbrt", "heightfield", 16),
+    ("translucent.pbrt", "translucent", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's
