@@ -418,6 +418,9 @@ fn sample_area(world: &Geometry, kind: PrimKind, u: Vec2) -> (Vec3, Vec3) {
         PrimKind::Sphere(i) => world.spheres[i as usize].sample_area(u),
         PrimKind::Disk(i) => world.disks[i as usize].sample_area(u),
         PrimKind::Cylinder(i) => world.cylinders[i as usize].sample_area(u),
+        // Never an emitter: the scene refuses area lights on these shapes (pbrt-v3 cannot
+        // sample them either). A point with no normal contributes nothing.
+        PrimKind::Revolved(_) => (Vec3::ZERO, Vec3::ZERO),
     }
 }
 
@@ -430,6 +433,8 @@ pub fn prim_area(world: &Geometry, kind: PrimKind) -> f32 {
         PrimKind::Sphere(i) => world.spheres[i as usize].area(),
         PrimKind::Disk(i) => world.disks[i as usize].area(),
         PrimKind::Cylinder(i) => world.cylinders[i as usize].area(),
+        // Never an emitter (see `sample_area`).
+        PrimKind::Revolved(_) => 0.0,
     }
 }
 

@@ -157,7 +157,7 @@ struct LightChoices {
 }
 
 /// Shape types pbrt-v3 has and acr does not: warned about once and skipped.
-const UNSUPPORTED_SHAPES: &[&str] = &["curve", "nurbs", "cone", "paraboloid", "hyperboloid"];
+const UNSUPPORTED_SHAPES: &[&str] = &["curve", "nurbs"];
 
 /// Builds scenes, collecting warnings.
 struct Builder<'a> {
@@ -268,7 +268,7 @@ impl Builder<'_> {
             );
             return Ok(());
         }
-        let area_light = shape.area_light.as_ref().filter(|_| emit);
+        let mut area_light = shape.area_light.as_ref().filter(|_| emit);
         let material = shape.material.map(|m| m as u32);
         let to_world = transform_of(m);
         let params = &p.params;
@@ -360,6 +360,34 @@ impl Builder<'_> {
                 );
                 prims.push(PrimKind::Cylinder(geom.cylinders.len() as u32));
                 geom.cylinders.push(c);
+            }
+            "cone" | "paraboloid" | "hyperboloid" => {
+                let built = crate::shapes::revolved::from_params(
+                    kind,
+                    params,
+                    to_world,
+                    shape.reverse_orientation,
+                )?;
+                let shape = match built {
+                    Ok(s) => s,
+                    Err(why) => {
+                        self.warnings.push(Warning::at(&p.loc, why));
+                        return Ok(());
+                    }
+                };
+                if area_light.is_some() {
+                    self.warnings.push(Warning::at(
+                        &p.loc,
+                        format!(
+                            "AreaLightSource on a {kind}: pbrt-v3 cannot sample it (its \
+                             {kind} has no Sample and aborts); the shape is rendered without \
+                             emission"
+                        ),
+                    ));
+                    area_light = None;
+                }
+                prims.push(PrimKind::Revolved(geom.revolved.len() as u32));
+                geom.revolved.push(shape);
             }
             other => {
                 self.warn_once(

@@ -307,6 +307,7 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("environment-camera.pbrt", "environment-camera", 16),
     ("heightfield.pbrt", "heightfield", 16),
     ("translucent.pbrt", "translucent", 16),
+    ("quadrics.pbrt", "quadrics", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

@@ -10,7 +10,7 @@ use crate::geometry::{Ray, SurfaceInteraction, Vec3};
 use crate::shapes::triangle::{
     intersect_triangle_verts, triangle_bounds, triangle_interaction, TriangleRay, TriangleVerts,
 };
-use crate::shapes::{Cylinder, Disk, Sphere, TriangleMesh};
+use crate::shapes::{Cylinder, Disk, Revolved, Sphere, TriangleMesh};
 use crate::transform::MotionTransform;
 use glam::{Mat4, Vec3A};
 use obvhs::aabb::Aabb;
@@ -48,6 +48,8 @@ pub enum PrimKind {
     Disk(u32),
     /// A cylinder.
     Cylinder(u32),
+    /// A cone, paraboloid or hyperboloid.
+    Revolved(u32),
 }
 
 /// Shapes in one space (the world, or an instance's), with a BVH over them.
@@ -61,6 +63,8 @@ pub struct Geometry {
     pub disks: Vec<Disk>,
     /// Cylinders.
     pub cylinders: Vec<Cylinder>,
+    /// Cones, paraboloids and hyperboloids.
+    pub revolved: Vec<Revolved>,
     /// Primitives in BVH leaf order.
     prims: Vec<Prim>,
     /// The vertices of each triangle primitive, in leaf order beside `prims` (zeros for other
@@ -78,6 +82,7 @@ enum LocalHit {
     Sphere(crate::shapes::sphere::SphereHit),
     Disk(crate::shapes::disk::DiskHit),
     Cylinder(crate::shapes::cylinder::CylinderHit),
+    Revolved(crate::shapes::RevolvedHit),
 }
 
 /// The closest hit of a ray.
@@ -130,6 +135,7 @@ impl Geometry {
             PrimKind::Sphere(i) => self.spheres[i as usize].world_bound(),
             PrimKind::Disk(i) => self.disks[i as usize].world_bound(),
             PrimKind::Cylinder(i) => self.cylinders[i as usize].world_bound(),
+            PrimKind::Revolved(i) => self.revolved[i as usize].world_bound(),
         }
     }
 
@@ -233,6 +239,9 @@ impl Geometry {
             PrimKind::Cylinder(i) => self.cylinders[i as usize]
                 .intersect(ray, t_max)
                 .map(|(t, h)| (t, LocalHit::Cylinder(h))),
+            PrimKind::Revolved(i) => self.revolved[i as usize]
+                .intersect(ray, t_max)
+                .map(|(t, h)| (t, LocalHit::Revolved(h))),
         }
     }
 
@@ -286,6 +295,9 @@ impl Geometry {
             }
             (PrimKind::Cylinder(i), LocalHit::Cylinder(h)) => {
                 self.cylinders[i as usize].interaction(ray, hit.t, h)
+            }
+            (PrimKind::Revolved(i), LocalHit::Revolved(h)) => {
+                self.revolved[i as usize].interaction(ray, h)
             }
             // A hit always records the local data of its own primitive kind.
             _ => unreachable_interaction(ray, hit.t),

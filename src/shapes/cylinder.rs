@@ -1,7 +1,10 @@
 //! pbrt-v3's cylinder: x^2 + y^2 = r^2 around the object z axis, for z in [zmin, zmax] and
 //! phi in [0, phimax] (no caps).
 
-use super::{phi_max_radians, phi_of, quadratic_roots, quadric_interaction, world_area, Transform};
+use super::quadric::{
+    nearest_root, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, world_area,
+};
+use super::Transform;
 use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
 
 /// A cylinder shape (pbrt-v3 `cylinder`). Build it with [`Cylinder::new`].
@@ -113,31 +116,11 @@ impl Cylinder {
         let (vx, vy) = (ox - f * dx, oy - f * dy);
         let l = (vx * vx + vy * vy).sqrt();
         let discrim = 4.0 * a * (r + l) * (r - l);
-        let (t0, t1) = quadratic_roots(a, b, c, discrim)?;
-        let t_max64 = t_max as f64;
-        if t0 > t_max64 || t1 <= 0.0 {
-            return None;
-        }
-        let mut t = t0;
-        if t <= 0.0 {
-            t = t1;
-            if t > t_max64 {
-                return None;
-            }
-        }
-        let (mut p, mut phi) = self.hit_at(o, d, t as f32);
-        if self.clipped(p, phi) {
-            if t == t1 || t1 > t_max64 {
-                return None;
-            }
-            t = t1;
-            (p, phi) = self.hit_at(o, d, t as f32);
-            if self.clipped(p, phi) {
-                return None;
-            }
-        }
-        let t = t as f32;
-        (t > 0.0).then_some((t, CylinderHit { p, phi }))
+        let roots = quadratic_roots(a, b, c, discrim)?;
+        nearest_root(roots, t_max, |t| {
+            let (p, phi) = self.hit_at(o, d, t);
+            (!self.clipped(p, phi)).then_some(CylinderHit { p, phi })
+        })
     }
 
     /// Any-hit variant of [`Cylinder::intersect`].

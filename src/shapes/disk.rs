@@ -1,7 +1,8 @@
 //! pbrt-v3's disk: an annulus in the plane z = height, between innerradius and radius, cut at
 //! phi = phimax.
 
-use super::{phi_max_radians, phi_of, quadric_interaction, world_area, Transform};
+use super::quadric::{phi_max_radians, phi_of, quadric_interaction, world_area};
+use super::Transform;
 use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
 use crate::sampling::concentric_sample_disk;
 use std::f32::consts::PI;

@@ -1,10 +1,11 @@
 //! pbrt-v3's sphere: a (possibly partial) sphere around the object-space origin, cut by
 //! z in [zmin, zmax] and phi in [0, phimax].
 
-use super::{
-    coordinate_system, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, world_area,
-    Transform,
+use super::coordinate_system;
+use super::quadric::{
+    nearest_root, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, world_area,
 };
+use super::Transform;
 use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
 use crate::sampling::uniform_sample_sphere;
 use std::f32::consts::PI;
@@ -142,31 +143,11 @@ impl Sphere {
         // Discriminant without cancellation (pbrt-v4): 4 a (r^2 - |o - (b / 2a) d|^2).
         let l = (od - dd * (b / (2.0 * a))).length();
         let discrim = 4.0 * a * (r + l) * (r - l);
-        let (t0, t1) = quadratic_roots(a, b, c, discrim)?;
-        let t_max64 = t_max as f64;
-        if t0 > t_max64 || t1 <= 0.0 {
-            return None;
-        }
-        let mut t = t0;
-        if t <= 0.0 {
-            t = t1;
-            if t > t_max64 {
-                return None;
-            }
-        }
-        let (mut p, mut phi) = self.hit_at(o, d, t as f32);
-        if self.clipped(p, phi) {
-            if t == t1 || t1 > t_max64 {
-                return None;
-            }
-            t = t1;
-            (p, phi) = self.hit_at(o, d, t as f32);
-            if self.clipped(p, phi) {
-                return None;
-            }
-        }
-        let t = t as f32;
-        (t > 0.0).then_some((t, SphereHit { p, phi }))
+        let roots = quadratic_roots(a, b, c, discrim)?;
+        nearest_root(roots, t_max, |t| {
+            let (p, phi) = self.hit_at(o, d, t);
+            (!self.clipped(p, phi)).then_some(SphereHit { p, phi })
+        })
     }
 
     /// Any-hit variant of [`Sphere::intersect`].
