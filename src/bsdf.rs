@@ -1445,6 +1445,7 @@ mod tests {
             dndv: Vec3::ZERO,
             wo: Vec3::Y,
             time: 0.0,
+            p_error: 0.0,
         };
         let b = Bsdf::new(&si, 1.0);
         assert!((b.frame().n - Vec3::Y).length() < 1e-6);

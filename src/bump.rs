@@ -66,6 +66,7 @@ mod tests {
             dndv: Vec3::ZERO,
             wo: Vec3::Z,
             time: 0.0,
+            p_error: 0.0,
         }
     }
 
@@ -162,6 +163,7 @@ mod tests {
                 dndv: dpdv / 0.9,
                 wo: -n,
                 time: 0.0,
+                p_error: 0.0,
             };
             let got = bump(&d, &hit).shading_n;
             let want = Vec3::from_array(want);

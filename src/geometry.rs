@@ -109,6 +109,9 @@ pub struct SurfaceInteraction {
     pub wo: Vec3,
     /// The ray's time.
     pub time: f32,
+    /// How far off the surface spawned rays start, beyond the rounding offset: pbrt-v3's error
+    /// bound where it is large (two widths on curves, which face every ray); 0 elsewhere.
+    pub p_error: f32,
 }
 
 /// Offsets a point off a surface so that a ray leaving it does not hit that surface again.
@@ -160,13 +163,19 @@ impl SurfaceInteraction {
     /// A ray leaving the surface along `d`, its origin offset to the side `d` points to.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        Ray::new(offset_ray_origin(self.p, self.n_towards(d)), d, self.time)
+        let n = self.n_towards(d);
+        Ray::new(
+            offset_ray_origin(self.p + n * self.p_error, n),
+            d,
+            self.time,
+        )
     }
 
     /// A shadow ray towards `target` and the parameter just short of it (for t in (0, tmax)).
     #[inline]
     pub fn spawn_ray_to(&self, target: Vec3) -> (Ray, f32) {
-        let o = offset_ray_origin(self.p, self.n_towards(target - self.p));
+        let n = self.n_towards(target - self.p);
+        let o = offset_ray_origin(self.p + n * self.p_error, n);
         (Ray::new(o, target - o, self.time), 1.0 - SHADOW_EPSILON)
     }
 }

@@ -14,6 +14,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
+pub mod light_image;
 pub mod lightbvh;
 pub mod lightdistrib;
 pub mod material;

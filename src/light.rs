@@ -1,9 +1,11 @@
-//! Light sources as pbrt-v3 defines them: point, spot, distant, diffuse area and infinite
-//! (constant, or an environment map sampled by importance).
+//! Light sources as pbrt-v3 defines them: point, spot, goniometric, projection, distant,
+//! diffuse area and infinite (constant, or an environment map sampled by importance). The
+//! goniometric and projection lights' image mappings are in [`crate::light_image`].
 
 use crate::accel::{Geometry, PrimKind};
 use crate::geometry::{Frame, Spectrum, SurfaceInteraction, Vec2, Vec3};
 use crate::image_io::RgbImage;
+use crate::light_image::{delta_sample, goniometric_scale, ImageProjection, LightImage};
 use crate::sampling::Distribution2D;
 use crate::shapes::triangle::{sample_triangle, triangle_area};
 use glam::Mat4;
@@ -57,6 +59,29 @@ pub enum Light {
         cos_total: f32,
         /// Cosine of where the falloff starts.
         cos_falloff_start: f32,
+    },
+    /// `goniometric`: a point light whose intensity in each direction is scaled by an image
+    /// over (phi, theta) around its y axis.
+    Goniometric {
+        /// World position.
+        pos: Vec3,
+        /// Light-from-world (the light's own transform, scale included, inverted).
+        light_from_world: Mat4,
+        /// Intensity.
+        intensity: Spectrum,
+        /// The image, if any (without one, the intensity in every direction).
+        map: Option<LightImage>,
+    },
+    /// `projection`: a point light casting an image through a perspective frustum along its +z.
+    Projection {
+        /// World position.
+        pos: Vec3,
+        /// Light-from-world (the light's own transform, scale included, inverted).
+        light_from_world: Mat4,
+        /// Intensity.
+        intensity: Spectrum,
+        /// The frustum and its image.
+        projection: ImageProjection,
     },
     /// `distant`: parallel light from one direction.
     Distant {
@@ -151,11 +176,16 @@ impl EnvMap {
 }
 
 impl Light {
-    /// True for lights that a ray can never hit (point, spot, distant).
+    /// True for lights that a ray can never hit (point, spot, goniometric, projection,
+    /// distant).
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
-            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+            Light::Point { .. }
+                | Light::Spot { .. }
+                | Light::Goniometric { .. }
+                | Light::Projection { .. }
+                | Light::Distant { .. }
         )
     }
 
@@ -169,6 +199,23 @@ impl Light {
                 cos_falloff_start,
                 ..
             } => *intensity * 2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total)),
+            // pbrt-v3: 4 pi I times the image's mean (see `LightImage::average`).
+            Light::Goniometric { intensity, map, .. } => {
+                *intensity * 4.0 * PI * map.as_ref().map_or(Spectrum::ONE, |m| m.average())
+            }
+            // pbrt-v3: the image's mean times I times the solid angle of the cone through the
+            // screen window's corners.
+            Light::Projection {
+                intensity,
+                projection,
+                ..
+            } => {
+                projection.map().map_or(Spectrum::ONE, |m| m.average())
+                    * *intensity
+                    * 2.0
+                    * PI
+                    * (1.0 - projection.cos_total_width)
+            }
             Light::Distant {
                 radiance,
                 world_radius,
@@ -234,6 +281,33 @@ impl Light {
                     pdf: 1.0,
                     p: *pos,
                 })
+            }
+            // pbrt-v3's Sample_Li: intensity scaled by the image in the direction the light
+            // sends towards p (-wi, in light space), over the squared distance, pdf 1.
+            Light::Goniometric {
+                pos,
+                light_from_world,
+                intensity,
+                map,
+            } => {
+                let wi = (*pos - p).normalize();
+                let wl = light_from_world.transform_vector3(-wi);
+                delta_sample(
+                    *pos,
+                    p,
+                    wi,
+                    *intensity * goniometric_scale(map.as_ref(), wl),
+                )
+            }
+            Light::Projection {
+                pos,
+                light_from_world,
+                intensity,
+                projection,
+            } => {
+                let wi = (*pos - p).normalize();
+                let wl = light_from_world.transform_vector3(-wi);
+                delta_sample(*pos, p, wi, *intensity * projection.eval(wl))
             }
             Light::Distant {
                 w,
@@ -420,7 +494,7 @@ fn sample_area(world: &Geometry, kind: PrimKind, u: Vec2) -> (Vec3, Vec3) {
         PrimKind::Cylinder(i) => world.cylinders[i as usize].sample_area(u),
         // Never an emitter: the scene refuses area lights on these shapes (pbrt-v3 cannot
         // sample them either). A point with no normal contributes nothing.
-        PrimKind::Revolved(_) => (Vec3::ZERO, Vec3::ZERO),
+        PrimKind::Revolved(_) | PrimKind::Curve(_) => (Vec3::ZERO, Vec3::ZERO),
     }
 }
 
@@ -434,7 +508,7 @@ pub fn prim_area(world: &Geometry, kind: PrimKind) -> f32 {
         PrimKind::Disk(i) => world.disks[i as usize].area(),
         PrimKind::Cylinder(i) => world.cylinders[i as usize].area(),
         // Never an emitter (see `sample_area`).
-        PrimKind::Revolved(_) => 0.0,
+        PrimKind::Revolved(_) | PrimKind::Curve(_) => 0.0,
     }
 }
 

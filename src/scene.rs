@@ -6,6 +6,7 @@ use crate::camera::Camera;
 use crate::film::FilmSettings;
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3};
 use crate::light::{prim_area, spot_frame, AreaShape, EnvMap, Light};
+use crate::light_image::LightImage;
 use crate::lightbvh::{LightBvh, LightContext};
 use crate::lightdistrib::{LightDistribution, LightPmf, LightStrategy};
 use crate::material::Material;
@@ -157,7 +158,7 @@ struct LightChoices {
 }
 
 /// Shape types pbrt-v3 has and acr does not: warned about once and skipped.
-const UNSUPPORTED_SHAPES: &[&str] = &["curve", "nurbs"];
+const UNSUPPORTED_SHAPES: &[&str] = &[];
 
 /// Builds scenes, collecting warnings.
 struct Builder<'a> {
@@ -189,6 +190,22 @@ impl Builder<'_> {
     /// Whether a shape's size is positive and finite; if not, warns that the shape is skipped
     /// (a zero or negative radius makes a shape with no area, which no ray can hit and no
     /// light can sample without dividing by zero).
+    /// Drops the area light of a shape pbrt-v3 cannot sample (its `Sample` aborts), with a
+    /// warning: the shape renders, unlit by itself.
+    fn no_emission<'l, L>(&mut self, area_light: Option<&'l L>, p: &PluginDesc) -> Option<&'l L> {
+        if area_light.is_some() {
+            self.warnings.push(Warning::at(
+                &p.loc,
+                format!(
+                    "AreaLightSource on a {0}: pbrt-v3 cannot sample a {0} (its Sample aborts); \
+                     the shape is rendered without emission",
+                    p.kind
+                ),
+            ));
+        }
+        None
+    }
+
     fn positive_size(&mut self, p: &PluginDesc, what: &str, v: f32) -> bool {
         if v > 0.0 && v.is_finite() {
             return true;
@@ -302,6 +319,11 @@ impl Builder<'_> {
                 let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
                 self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
             }
+            "nurbs" => {
+                let mesh = crate::shapes::nurbs::mesh_from_params(params, &p.loc)?;
+                let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
+                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
+            }
             "sphere" => {
                 let r = params.float_or("radius", 1.0)? as f32;
                 if !self.positive_size(p, "radius", r) {
@@ -375,19 +397,28 @@ impl Builder<'_> {
                         return Ok(());
                     }
                 };
-                if area_light.is_some() {
-                    self.warnings.push(Warning::at(
-                        &p.loc,
-                        format!(
-                            "AreaLightSource on a {kind}: pbrt-v3 cannot sample it (its \
-                             {kind} has no Sample and aborts); the shape is rendered without \
-                             emission"
-                        ),
-                    ));
-                    area_light = None;
-                }
+                area_light = self.no_emission(area_light, p);
                 prims.push(PrimKind::Revolved(geom.revolved.len() as u32));
                 geom.revolved.push(shape);
+            }
+            "curve" => {
+                let curves = crate::shapes::curve::from_params(
+                    params,
+                    &p.loc,
+                    to_world,
+                    shape.reverse_orientation,
+                    self.warnings,
+                )?;
+                area_light = self.no_emission(area_light, p);
+                for (common, pieces) in curves {
+                    let index = geom.curve_commons.len() as u32;
+                    geom.curve_commons.push(common);
+                    for mut piece in pieces {
+                        piece.common = index;
+                        prims.push(PrimKind::Curve(geom.curves.len() as u32));
+                        geom.curves.push(piece);
+                    }
+                }
             }
             other => {
                 self.warn_once(
@@ -494,7 +525,7 @@ impl Builder<'_> {
                     world_radius,
                 }
             }
-            "infinite" => {
+            "infinite" | "exinfinite" => {
                 let l = rgb_param(params, "L", Spectrum::ONE)? * scale;
                 let map = match params.string("mapname")? {
                     Some(name) if !name.is_empty() => {
@@ -523,15 +554,42 @@ impl Builder<'_> {
                 }
             }
             "goniometric" | "projection" => {
-                self.warn_once(
-                    format!("light {}", p.kind),
-                    &p.loc,
-                    format!("light \"{}\" is not supported; skipped", p.kind),
-                );
-                return Ok(None);
+                let intensity = rgb_param(params, "I", Spectrum::ONE)? * scale;
+                // pbrt-v3 reads the image with ReadImage: PNG values as stored, no sRGB
+                // decoding. Without "mapname" it has no image (and emits I unscaled); acr
+                // makes an unreadable one an error where pbrt-v3 goes on without it.
+                let map = match params.string("mapname")? {
+                    Some(name) if !name.is_empty() => {
+                        let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
+                        let path = crate::texture::resolve_file(name, loc, main_dir);
+                        let img = crate::image_io::read_image(&path, false)
+                            .map_err(|e| Error::at(loc, format!("cannot read \"{name}\": {e}")))?;
+                        Some(
+                            LightImage::new(&img).ok_or_else(|| {
+                                Error::at(loc, format!("\"{name}\" has no pixels"))
+                            })?,
+                        )
+                    }
+                    _ => None,
+                };
+                let light = if p.kind == "goniometric" {
+                    Light::goniometric(world_from_light, intensity, map)
+                } else {
+                    let fov = params.float_or("fov", 45.0)? as f32;
+                    Light::projection(world_from_light, intensity, map, fov)
+                };
+                light.map_err(|e| Error::at(&p.loc, format!("{} light: {e}", p.kind)))?
             }
             other => {
-                let hint = acr_parser::closest(other, ["point", "spot", "distant", "infinite"])
+                let kinds = [
+                    "point",
+                    "spot",
+                    "goniometric",
+                    "projection",
+                    "distant",
+                    "infinite",
+                ];
+                let hint = acr_parser::closest(other, kinds)
                     .map_or(String::new(), |k| format!(" (did you mean {k}?)"));
                 return Err(Error::at(
                     &p.loc,

@@ -1123,6 +1123,7 @@ mod tests {
             dndv: Vec3::ZERO,
             wo: Vec3::Z,
             time: 0.0,
+            p_error: 0.0,
         }
     }
 

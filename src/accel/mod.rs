@@ -10,7 +10,7 @@ use crate::geometry::{Ray, SurfaceInteraction, Vec3};
 use crate::shapes::triangle::{
     intersect_triangle_verts, triangle_bounds, triangle_interaction, TriangleRay, TriangleVerts,
 };
-use crate::shapes::{Cylinder, Disk, Revolved, Sphere, TriangleMesh};
+use crate::shapes::{Curve, CurveCommon, Cylinder, Disk, Revolved, Sphere, TriangleMesh};
 use crate::transform::MotionTransform;
 use glam::{Mat4, Vec3A};
 use obvhs::aabb::Aabb;
@@ -50,6 +50,8 @@ pub enum PrimKind {
     Cylinder(u32),
     /// A cone, paraboloid or hyperboloid.
     Revolved(u32),
+    /// A piece of a curve.
+    Curve(u32),
 }
 
 /// Shapes in one space (the world, or an instance's), with a BVH over them.
@@ -65,6 +67,10 @@ pub struct Geometry {
     pub cylinders: Vec<Cylinder>,
     /// Cones, paraboloids and hyperboloids.
     pub revolved: Vec<Revolved>,
+    /// What the pieces of each curve segment share.
+    pub curve_commons: Vec<CurveCommon>,
+    /// Curve pieces.
+    pub curves: Vec<Curve>,
     /// Primitives in BVH leaf order.
     prims: Vec<Prim>,
     /// The vertices of each triangle primitive, in leaf order beside `prims` (zeros for other
@@ -83,6 +89,7 @@ enum LocalHit {
     Disk(crate::shapes::disk::DiskHit),
     Cylinder(crate::shapes::cylinder::CylinderHit),
     Revolved(crate::shapes::RevolvedHit),
+    Curve(crate::shapes::CurveHit),
 }
 
 /// The closest hit of a ray.
@@ -136,6 +143,10 @@ impl Geometry {
             PrimKind::Disk(i) => self.disks[i as usize].world_bound(),
             PrimKind::Cylinder(i) => self.cylinders[i as usize].world_bound(),
             PrimKind::Revolved(i) => self.revolved[i as usize].world_bound(),
+            PrimKind::Curve(i) => {
+                let c = &self.curves[i as usize];
+                c.world_bound(&self.curve_commons[c.common as usize])
+            }
         }
     }
 
@@ -242,6 +253,11 @@ impl Geometry {
             PrimKind::Revolved(i) => self.revolved[i as usize]
                 .intersect(ray, t_max)
                 .map(|(t, h)| (t, LocalHit::Revolved(h))),
+            PrimKind::Curve(i) => {
+                let c = &self.curves[i as usize];
+                c.intersect(&self.curve_commons[c.common as usize], ray, t_max)
+                    .map(|(t, h)| (t, LocalHit::Curve(h)))
+            }
         }
     }
 
@@ -299,6 +315,10 @@ impl Geometry {
             (PrimKind::Revolved(i), LocalHit::Revolved(h)) => {
                 self.revolved[i as usize].interaction(ray, h)
             }
+            (PrimKind::Curve(i), LocalHit::Curve(h)) => {
+                let c = &self.curves[i as usize];
+                c.interaction(&self.curve_commons[c.common as usize], ray, hit.t, h)
+            }
             // A hit always records the local data of its own primitive kind.
             _ => unreachable_interaction(ray, hit.t),
         }
@@ -323,6 +343,7 @@ fn unreachable_interaction(ray: &Ray, t: f32) -> SurfaceInteraction {
         dndv: Vec3::ZERO,
         wo: n,
         time: ray.time,
+        p_error: 0.0,
     }
 }
 
@@ -549,6 +570,13 @@ fn transform_interaction(
         dndv: to_local.transpose().transform_vector3(si.dndv),
         wo: -world_ray.d.normalize(),
         time: si.time,
+        p_error: si.p_error
+            * to_world
+                .x_axis
+                .truncate()
+                .length()
+                .max(to_world.y_axis.truncate().length())
+                .max(to_world.z_axis.truncate().length()),
     }
 }
 

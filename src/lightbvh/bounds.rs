@@ -99,6 +99,51 @@ impl LightBounds {
                 cos_theta_e: (safe_acos(*cos_total) - safe_acos(*cos_falloff_start)).cos(),
                 two_sided: false,
             }),
+            // As pbrt-v4's GoniometricLight::Bounds: a point light whose power is its mean over
+            // the image (4 pi I times the mean of each pixel's largest channel), every direction.
+            Light::Goniometric {
+                pos,
+                intensity,
+                map,
+                ..
+            } => Some(Self {
+                lo: *pos,
+                hi: *pos,
+                w: Vec3::Z,
+                phi: 4.0
+                    * PI
+                    * map
+                        .as_ref()
+                        .map_or(intensity.max_element(), |m| m.mean_max(*intensity)),
+                cos_theta_o: -1.0,
+                cos_theta_e: 0.0,
+                two_sided: false,
+            }),
+            // As pbrt-v4's ProjectionLight::Bounds: one axis (theta_o = 0) and the frustum's cone
+            // past it; power as a point light's, times the image's mean, like the spot's (the
+            // cone is accounted for by the importance).
+            Light::Projection {
+                pos,
+                light_from_world,
+                intensity,
+                projection,
+            } => {
+                let (w, cos_e) = projection.world_cone(&light_from_world.inverse());
+                let all = cos_e <= -1.0;
+                Some(Self {
+                    lo: *pos,
+                    hi: *pos,
+                    w,
+                    phi: 4.0
+                        * PI
+                        * projection
+                            .map()
+                            .map_or(intensity.max_element(), |m| m.mean_max(*intensity)),
+                    cos_theta_o: if all { -1.0 } else { 1.0 },
+                    cos_theta_e: if all { 0.0 } else { cos_e },
+                    two_sided: false,
+                })
+            }
             Light::Distant { .. } | Light::Infinite { .. } => None,
             Light::Area {
                 shape,

@@ -5,17 +5,20 @@
 //! pbrt-v3 so that texture coordinates and shading agree with its images.
 
 pub mod cone;
+pub mod curve;
 pub mod cylinder;
 pub mod disk;
 pub mod heightfield;
 pub mod hyperboloid;
 pub mod loopsubdiv;
+pub mod nurbs;
 pub mod paraboloid;
 pub mod quadric;
 pub mod revolved;
 pub mod sphere;
 pub mod triangle;
 
+pub use curve::{Curve, CurveCommon, CurveHit};
 pub use cylinder::{Cylinder, CylinderHit};
 pub use disk::{Disk, DiskHit};
 pub use revolved::{Revolved, RevolvedHit};

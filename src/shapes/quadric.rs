@@ -108,6 +108,7 @@ pub(crate) fn quadric_interaction(
         dndv: to_world.normal(dndv),
         wo: (-ray.d).normalize_or_zero(),
         time: ray.time,
+        p_error: 0.0,
     }
 }
 

@@ -404,6 +404,7 @@ pub fn triangle_interaction(
         dndv: Vec3::ZERO,
         wo: (-ray.d).normalize_or_zero(),
         time: ray.time,
+        p_error: 0.0,
     }
 }
 
