@@ -1,9 +1,8 @@
-//! acr: adaptive cluster rendering of pbrt-v3 scenes. This crate holds the renderer core and the
-//! command line; the parser and the plugins live in their own crates.
+//! acr: adaptive cluster rendering of pbrt-v3 scenes. This crate holds the renderer core and, in
+//! `cli/`, the command-line tools on top of it; the parser and the plugins live in their own
+//! crates.
 
 pub mod accel;
-pub mod aov;
-pub mod bench;
 pub mod bsdf;
 pub mod bump;
 pub mod camera;
@@ -24,12 +23,10 @@ pub mod noise;
 pub mod procedural;
 pub mod registry;
 pub mod render;
-pub mod replay;
 pub mod sampling;
 pub mod scene;
 pub mod shapes;
 pub mod spectrum;
-pub mod stats;
 pub mod stream;
 pub mod texture;
 pub mod transform;

@@ -4,197 +4,19 @@
 //! error against time per scene and a Markdown report. Each render is a separate `acr render`
 //! process, so that its time and peak memory are its own and a crash is only a failed row.
 
+use crate::cli::stats::median;
 use crate::image_io::read_image;
 use crate::metrics::{compare, Metrics};
-use crate::stats::median;
-use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-/// The manifest: scenes, methods, budgets and references.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Manifest {
-    /// A title for the report.
-    #[serde(default)]
-    pub title: Option<String>,
-    /// Seed of every run.
-    #[serde(default)]
-    pub seed: u64,
-    /// Worker threads per run (default: every core).
-    #[serde(default)]
-    pub threads: Option<u32>,
-    /// Folder of cached reference renders, relative to the manifest (default `cache`).
-    #[serde(default)]
-    pub cache: Option<PathBuf>,
-    /// The budgets.
-    pub budgets: Budgets,
-    /// The reference of scenes that name none.
-    #[serde(default)]
-    pub reference: Option<Reference>,
-    /// The scenes.
-    #[serde(rename = "scene")]
-    pub scenes: Vec<SceneEntry>,
-    /// The methods; the first is the baseline of every ratio.
-    #[serde(rename = "method")]
-    pub methods: Vec<Method>,
-    /// Runs that measure the sampler's share of wall time, if any.
-    #[serde(default)]
-    pub sampler_cost: Option<SamplerCostRuns>,
-}
+mod manifest;
+mod report;
 
-/// The sampler's share of wall time (`acr render --sampler-cost`) of every scene and method,
-/// at some budgets: each run is its own process, and the report gives the median over them,
-/// since one process's share moves with the machine's load.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SamplerCostRuns {
-    /// Samples per pixel to measure at.
-    pub spp: Vec<u32>,
-    /// Processes per scene, method and budget.
-    #[serde(default = "five")]
-    pub runs: u32,
-}
-
-fn five() -> u32 {
-    5
-}
-
-/// Most processes per scene, method and budget in a sampler-cost measure.
-const MAX_COST_RUNS: u32 = 100;
-
-/// Samples per pixel to run at, and whether to run equal-time too.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Budgets {
-    /// Samples per pixel (equal-spp runs).
-    pub spp: Vec<u32>,
-    /// Also run every method but the first with `--time-limit` set to the first method's
-    /// render time at each budget.
-    #[serde(default = "yes")]
-    pub equal_time: bool,
-}
-
-fn yes() -> bool {
-    true
-}
-
-/// One scene of the manifest.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SceneEntry {
-    /// Its label in the report.
-    pub name: String,
-    /// The .pbrt file, relative to the manifest.
-    pub path: PathBuf,
-    /// Its reference (else the manifest's).
-    #[serde(default)]
-    pub reference: Option<Reference>,
-}
-
-/// A scene's reference image: a file, or a render by one of the methods at a high budget.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(untagged, deny_unknown_fields)]
-pub enum Reference {
-    /// A given image (EXR, PFM...), relative to the manifest.
-    Image {
-        /// The file.
-        image: PathBuf,
-    },
-    /// Rendered at `spp` by the manifest's method labelled `method`, or by the sampler,
-    /// filter, integrator and settings given here; cached.
-    Render {
-        /// A method's label.
-        #[serde(default)]
-        method: Option<String>,
-        /// `--sampler`, when no method is named.
-        #[serde(default)]
-        sampler: Option<String>,
-        /// `--filter`, when no method is named.
-        #[serde(default)]
-        filter: Option<String>,
-        /// `--integrator`, when no method is named.
-        #[serde(default)]
-        integrator: Option<String>,
-        /// `--set` settings, when no method is named.
-        #[serde(default)]
-        set: Vec<String>,
-        /// Samples per pixel.
-        spp: u32,
-    },
-}
-
-impl Reference {
-    /// The method a rendered reference uses.
-    fn method(&self, methods: &[Method]) -> Result<Option<Method>, String> {
-        match self {
-            Reference::Image { .. } => Ok(None),
-            Reference::Render {
-                method: Some(label),
-                ..
-            } => methods
-                .iter()
-                .find(|m| &m.label == label)
-                .cloned()
-                .map(Some)
-                .ok_or_else(|| format!("names method \"{label}\", which is not listed")),
-            Reference::Render {
-                method: None,
-                sampler,
-                filter,
-                integrator,
-                set,
-                ..
-            } => Ok(Some(Method {
-                label: "reference".to_owned(),
-                sampler: sampler.clone(),
-                filter: filter.clone(),
-                integrator: integrator.clone(),
-                set: set.clone(),
-            })),
-        }
-    }
-}
-
-/// A sampler + filter (+ integrator) with parameters, under a label.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Method {
-    /// Its name in the report (`stratified+box`).
-    pub label: String,
-    /// `--sampler` (default: the scene's).
-    #[serde(default)]
-    pub sampler: Option<String>,
-    /// `--filter` (default: the scene's).
-    #[serde(default)]
-    pub filter: Option<String>,
-    /// `--integrator` (default: the scene's).
-    #[serde(default)]
-    pub integrator: Option<String>,
-    /// `--set KIND.PARAM=VALUE` settings.
-    #[serde(default)]
-    pub set: Vec<String>,
-}
-
-/// How a run was budgeted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mode {
-    /// At a number of samples per pixel.
-    EqualSpp,
-    /// At the first method's time for that number of samples per pixel.
-    EqualTime,
-}
-
-impl Mode {
-    fn name(self) -> &'static str {
-        match self {
-            Mode::EqualSpp => "equal-spp",
-            Mode::EqualTime => "equal-time",
-        }
-    }
-}
+pub use manifest::*;
+pub use report::*;
 
 /// One row of the results.
 #[derive(Clone, Debug)]
@@ -290,86 +112,6 @@ pub struct BenchResults {
     pub rows: Vec<Row>,
     /// The sampler-cost measures.
     pub costs: Vec<CostRow>,
-}
-
-/// Reads and checks a manifest.
-pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-    let m: Manifest = toml::from_str(&text).map_err(|e| {
-        let (line, col) = e.span().map_or((1, 1), |s| line_col(&text, s.start));
-        format!("{}:{line}:{col}: {}", path.display(), e.message())
-    })?;
-    if m.methods.is_empty() || m.scenes.is_empty() || m.budgets.spp.is_empty() {
-        return Err(format!(
-            "{}: a manifest needs at least one [[scene]], one [[method]] and one budget",
-            path.display()
-        ));
-    }
-    if let Some(&bad) = m
-        .budgets
-        .spp
-        .iter()
-        .find(|&&s| s == 0 || s > crate::render::MAX_SPP)
-    {
-        return Err(format!(
-            "{}: budget {bad} spp is out of range",
-            path.display()
-        ));
-    }
-    if let Some(c) = &m.sampler_cost {
-        if let Some(&bad) = c
-            .spp
-            .iter()
-            .find(|&&s| s == 0 || s > crate::render::MAX_SPP)
-        {
-            return Err(format!(
-                "{}: sampler_cost budget {bad} spp is out of range",
-                path.display()
-            ));
-        }
-        if c.runs == 0 || c.runs > MAX_COST_RUNS {
-            return Err(format!(
-                "{}: sampler_cost runs {} is out of range (1 to {MAX_COST_RUNS})",
-                path.display(),
-                c.runs
-            ));
-        }
-    }
-    let mut labels = std::collections::HashSet::new();
-    for meth in &m.methods {
-        if !labels.insert(meth.label.as_str()) {
-            return Err(format!(
-                "{}: method \"{}\" is listed twice",
-                path.display(),
-                meth.label
-            ));
-        }
-    }
-    for s in &m.scenes {
-        let Some(r) = s.reference.as_ref().or(m.reference.as_ref()) else {
-            return Err(format!(
-                "{}: scene \"{}\" has no reference (give it one, or a top-level one)",
-                path.display(),
-                s.name
-            ));
-        };
-        r.method(&m.methods).map_err(|e| {
-            format!(
-                "{}: the reference of scene \"{}\" {e}",
-                path.display(),
-                s.name
-            )
-        })?;
-    }
-    Ok(m)
-}
-
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    (line, col)
 }
 
 /// FNV-1a, 64 bits: a stable hash for cache keys (std's hasher may change between releases).
@@ -816,213 +558,6 @@ fn file_safe(name: &str) -> String {
         .collect()
 }
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_owned()
-    }
-}
-
-/// The image's mean over the reference's (1 when the reference is black): a filter or sampler
-/// that moves the mean shows here whatever its MSE.
-fn mean_ratio(m: &crate::metrics::Metrics) -> f64 {
-    if m.reference_mean > 0.0 {
-        m.mean / m.reference_mean
-    } else {
-        1.0
-    }
-}
-
-/// The CSV: one row per run, failed runs with their reason.
-pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
-    let mut s = String::from(
-        "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
-         mean_ratio\n",
-    );
-    for r in rows {
-        let head = format!(
-            "{},{},{},{}",
-            csv_field(&r.scene),
-            csv_field(&r.method),
-            r.mode.name(),
-            r.spp
-        );
-        match &r.outcome {
-            Ok(m) => {
-                let _ = writeln!(
-                    s,
-                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok,{:.5}",
-                    m.seconds,
-                    m.samples,
-                    m.spp_reached,
-                    m.metrics.mse,
-                    m.metrics.relmse,
-                    m.metrics.psnr,
-                    m.peak_rss_mb,
-                    mean_ratio(&m.metrics)
-                );
-            }
-            Err(e) => {
-                let _ = writeln!(s, "{head},,,,,,,,{},", csv_field(&format!("failed: {e}")));
-            }
-        }
-    }
-    std::fs::write(path, s).map_err(|e| format!("{}: cannot write: {e}", path.display()))
-}
-
-/// The sampler-cost CSV: one row per scene, method and budget, with the median share over
-/// its runs, the least and the largest, and the median seconds of a render and of a replay.
-pub fn write_cost_csv(path: &Path, costs: &[CostRow]) -> Result<(), String> {
-    let mut s = String::from(
-        "scene,method,spp,runs,sampler_share,share_min,share_max,rerender_seconds,replay_seconds,status\n",
-    );
-    for c in costs {
-        let head = format!("{},{},{}", csv_field(&c.scene), csv_field(&c.method), c.spp);
-        match c.summary() {
-            Ok(c) => {
-                let _ = writeln!(
-                    s,
-                    "{head},{},{:.4},{:.4},{:.4},{:.6},{:.6},ok",
-                    c.runs, c.share, c.least, c.largest, c.rerender, c.replay
-                );
-            }
-            Err(e) => {
-                let _ = writeln!(s, "{head},,,,,,,{}", csv_field(&format!("failed: {e}")));
-            }
-        }
-    }
-    std::fs::write(path, s).map_err(|e| format!("{}: cannot write: {e}", path.display()))
-}
-
-/// The equal-spp and equal-time result of `method` on `scene` at `spp`.
-fn find<'a>(rows: &'a [Row], scene: &str, method: &str, spp: u32, mode: Mode) -> Option<&'a Row> {
-    rows.iter()
-        .find(|r| r.scene == scene && r.method == method && r.spp == spp && r.mode == mode)
-}
-
-/// The Markdown report: the setting, then per scene a table of equal-spp and equal-time errors
-/// with their ratios to the first method (below 1: better than the first method).
-pub fn report_markdown(
-    m: &Manifest,
-    manifest: &Path,
-    opts: &BenchOptions,
-    rows: &[Row],
-    costs: &[CostRow],
-) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "# {}\n", m.title.as_deref().unwrap_or("acr bench"));
-    let _ = writeln!(s, "- manifest: `{}`", manifest.display());
-    let _ = writeln!(s, "- command: `{}`", opts.command);
-    let _ = writeln!(s, "- machine: {}", machine());
-    let _ = writeln!(
-        s,
-        "- threads: {}",
-        m.threads.map_or_else(
-            || format!("all ({})", available_threads()),
-            |t| t.to_string()
-        )
-    );
-    let _ = writeln!(s, "- commit: {}", opts.commit);
-    let _ = writeln!(s, "- seed: {}", m.seed);
-    let _ = writeln!(
-        s,
-        "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds as `--time-limit` (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
-        m.methods[0].label
-    );
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
-    if failed > 0 {
-        let _ = writeln!(s, "**{failed} runs failed**; see `results.csv`.\n");
-    }
-    for scene in &m.scenes {
-        let _ = writeln!(s, "## {}\n", scene.name);
-        let _ = writeln!(s, "![{0}]({0}.png)\n", file_safe(&scene.name));
-        let _ = writeln!(
-            s,
-            "| spp | method | seconds | MSE | relMSE | MSE ratio | relMSE ratio | mean / reference | equal-time seconds | equal-time spp | equal-time MSE | MSE ratio | relMSE ratio |"
-        );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-        for &spp in &m.budgets.spp {
-            let base = find(rows, &scene.name, &m.methods[0].label, spp, Mode::EqualSpp)
-                .and_then(|r| r.outcome.as_ref().ok());
-            for meth in &m.methods {
-                let eq = find(rows, &scene.name, &meth.label, spp, Mode::EqualSpp);
-                let et = find(rows, &scene.name, &meth.label, spp, Mode::EqualTime);
-                let mut line = format!("| {spp} | {} ", meth.label);
-                match eq.map(|r| &r.outcome) {
-                    Some(Ok(r)) => {
-                        let _ = write!(
-                            line,
-                            "| {:.3} | {:.3e} | {:.3e} | {} | {} | {:.4} ",
-                            r.seconds,
-                            r.metrics.mse,
-                            r.metrics.relmse,
-                            ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
-                            ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse)),
-                            mean_ratio(&r.metrics)
-                        );
-                    }
-                    Some(Err(_)) => line.push_str("| failed | | | | | "),
-                    None => line.push_str("| | | | | | "),
-                }
-                match et.map(|r| &r.outcome) {
-                    Some(Ok(r)) => {
-                        let _ = write!(
-                            line,
-                            "| {:.3} | {:.1} | {:.3e} | {} | {} |",
-                            r.seconds,
-                            r.spp_reached,
-                            r.metrics.mse,
-                            ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
-                            ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse))
-                        );
-                    }
-                    Some(Err(_)) => line.push_str("| failed | | | | |"),
-                    None => line.push_str("| | | | | |"),
-                }
-                let _ = writeln!(s, "{line}");
-            }
-        }
-        s.push('\n');
-    }
-    if let Some(spec) = &m.sampler_cost {
-        let _ = writeln!(s, "## The sampler's share of wall time\n");
-        let _ = writeln!(
-            s,
-            "`acr render --sampler-cost`, {} processes each (`sampler_cost.csv`): a render by a fresh sampler against a replay of its points, share = (render - replay) / render; the median over the processes, then the least and the largest.\n",
-            spec.runs
-        );
-        let _ = writeln!(
-            s,
-            "| scene | spp | method | share | least | largest | render s | replay s |"
-        );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
-        for c in costs {
-            let figures = match c.summary() {
-                Ok(c) => format!(
-                    "{:.1}% | {:.1}% | {:.1}% | {:.3} | {:.3}",
-                    100.0 * c.share,
-                    100.0 * c.least,
-                    100.0 * c.largest,
-                    c.rerender,
-                    c.replay
-                ),
-                Err(_) => "failed | | | |".to_owned(),
-            };
-            let _ = writeln!(s, "| {} | {} | {} | {figures} |", c.scene, c.spp, c.method);
-        }
-        s.push('\n');
-    }
-    s
-}
-
-fn ratio(x: f64, base: Option<f64>) -> String {
-    match base {
-        Some(b) if b > 0.0 => format!("{:.3}", x / b),
-        _ => "-".to_owned(),
-    }
-}
-
 fn available_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
@@ -1056,128 +591,40 @@ pub fn commit() -> String {
         .unwrap_or_else(|| "unknown".to_owned())
 }
 
-/// Axis ticks at 1, 2 and 5 times the powers of ten within `lo..hi` (plotters' log axes label
-/// only powers of ten, which a narrow range may not contain).
-fn ticks(lo: f64, hi: f64) -> Vec<f64> {
-    let mut v = Vec::new();
-    let mut decade = 10f64.powf(lo.log10().floor());
-    while decade <= hi {
-        for m in [1.0, 2.0, 5.0] {
-            let t = decade * m;
-            if t >= lo && t <= hi {
-                v.push(t);
-            }
-        }
-        decade *= 10.0;
-    }
-    v
-}
-
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-
-/// Registers the embedded font with plotters once (its ab_glyph text needs one; no system
-/// font library is used).
-fn register_font() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        let _ =
-            plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT);
+/// `acr bench`: runs a manifest and writes its CSV, plots and report.
+pub fn command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
+    let out = out.unwrap_or_else(|| {
+        let stem = manifest
+            .file_stem()
+            .map_or_else(|| "bench".to_owned(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("bench-out").join(stem)
     });
-}
-
-/// The log-log plot of MSE against seconds for one scene: a line per method through its
-/// equal-spp runs, and its equal-time runs as hollow circles.
-pub fn plot_scene(
-    path: &Path,
-    scene: &str,
-    methods: &[Method],
-    rows: &[Row],
-) -> Result<(), String> {
-    use plotters::prelude::*;
-    register_font();
-    let ok: Vec<(&Row, &Measured)> = rows
-        .iter()
-        .filter(|r| r.scene == scene)
-        .filter_map(|r| r.outcome.as_ref().ok().map(|m| (r, m)))
-        .filter(|(_, m)| m.seconds > 0.0 && m.metrics.mse > 0.0)
-        .collect();
-    if ok.is_empty() {
-        return Err("no successful run to plot".to_owned());
-    }
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for (_, m) in &ok {
-        x0 = x0.min(m.seconds);
-        x1 = x1.max(m.seconds);
-        y0 = y0.min(m.metrics.mse);
-        y1 = y1.max(m.metrics.mse);
-    }
-    let pad = |lo: f64, hi: f64| (lo / 1.3, (hi * 1.3).max(lo * 1.5));
-    let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
-    let root = BitMapBackend::new(path, (720, 480)).into_drawing_area();
-    let e = |e: &dyn std::fmt::Display| e.to_string();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{scene}: MSE against time (dots: equal spp, rings: equal time)"),
-            ("sans-serif", 18),
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find acr itself: {e}"))?;
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let opts = BenchOptions {
+        exe,
+        out: out.clone(),
+        command,
+        commit: commit(),
+    };
+    let results = run_bench(manifest, &opts)?;
+    let rows = &results.rows;
+    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    let costs = &results.costs;
+    let costs_failed = costs.iter().filter(|c| c.outcome.is_err()).count();
+    let cost_note = if costs.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ", {} sampler-cost measures, {costs_failed} failed",
+            costs.len()
         )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(
-            (x0..x1).log_scale().with_key_points(ticks(x0, x1)),
-            (y0..y1).log_scale().with_key_points(ticks(y0, y1)),
-        )
-        .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .x_labels(8)
-        .y_labels(8)
-        .light_line_style(WHITE)
-        .x_desc("seconds (render + reconstruction)")
-        .y_desc("MSE")
-        .y_label_formatter(&|v| format!("{v:.1e}"))
-        .x_label_formatter(&|v| format!("{v:.2}"))
-        .draw()
-        .map_err(|x| e(&x))?;
-    for (k, meth) in methods.iter().enumerate() {
-        let colour = Palette99::pick(k).to_rgba();
-        let mut line: Vec<(f64, f64)> = ok
-            .iter()
-            .filter(|(r, _)| r.method == meth.label && r.mode == Mode::EqualSpp)
-            .map(|(_, m)| (m.seconds, m.metrics.mse))
-            .collect();
-        line.sort_by(|a, b| a.0.total_cmp(&b.0));
-        chart
-            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
-            .map_err(|x| e(&x))?
-            .label(meth.label.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-        chart
-            .draw_series(line.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-            .map_err(|x| e(&x))?;
-        let timed: Vec<(f64, f64)> = ok
-            .iter()
-            .filter(|(r, _)| r.method == meth.label && r.mode == Mode::EqualTime)
-            .map(|(_, m)| (m.seconds, m.metrics.mse))
-            .collect();
-        chart
-            .draw_series(
-                timed
-                    .iter()
-                    .map(|&p| Circle::new(p, 6, colour.stroke_width(1))),
-            )
-            .map_err(|x| e(&x))?;
-    }
-    chart
-        .configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.8))
-        .draw()
-        .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))?;
+    };
+    eprintln!(
+        "{} runs, {failed} failed{cost_note} -> {}",
+        rows.len(),
+        out.join("report.md").display()
+    );
     Ok(())
 }
 

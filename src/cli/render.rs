@@ -1,63 +1,20 @@
-//! The `acr` command line: subcommands and their arguments.
+//! `acr render`: a scene to an image, with AOVs, statistics and the sampler-cost measure.
 
-use crate::aov::{parse_aovs, write_aov, AovRequest};
+use super::{parse_seconds, parse_threshold};
+use crate::cli::aov::{parse_aovs, write_aov, AovRequest};
+use crate::cli::replay::{Recording, Replay};
+use crate::cli::stats::{median, peak_rss_mb, Seconds, Stats};
 use crate::features::FeatureImage;
 use crate::image_io::{write_image, RgbImage};
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
 use crate::render::{render, render_with_features, Halt, Stop, MAX_SPP};
-use crate::replay::{Recording, Replay};
 use crate::scene::Scene;
-use crate::stats::{median, peak_rss_mb, Seconds, Stats};
 use acr_parser::SceneDescription;
 use acr_plugins::{Film, SamplePoint, Sampler, Setting};
-use clap::{Parser, Subcommand};
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::time::Instant;
-
-/// Adaptive cluster rendering for pbrt-v3 scenes.
-#[derive(Parser, Debug)]
-#[command(name = "acr", version, about, long_about = None)]
-pub struct Cli {
-    /// What to do.
-    #[command(subcommand)]
-    pub command: Command,
-}
-
-/// The subcommands.
-#[derive(Subcommand, Debug)]
-pub enum Command {
-    /// Parse a scene and print its scene graph (as the snapshot tests see it).
-    Parse {
-        /// The .pbrt scene file.
-        scene: PathBuf,
-    },
-    /// Render a scene to an image (.exr, .png or .pfm).
-    Render(Box<RenderArgs>),
-    /// List every plugin (samplers, filters, integrators) with its parameters and defaults.
-    Plugins,
-    /// Time against error: render a manifest's scenes with its methods at its budgets, and
-    /// write a CSV, a plot per scene and a Markdown report.
-    Bench {
-        /// The manifest (TOML; see bench/ for examples).
-        manifest: PathBuf,
-        /// Output folder (default: bench-out/MANIFEST-NAME).
-        #[arg(long)]
-        out: Option<PathBuf>,
-    },
-    /// Compare an image with a reference: MSE, relMSE and PSNR (linear radiance).
-    Diff {
-        /// The image to judge (.exr, .pfm, .hdr or .png).
-        image: PathBuf,
-        /// The reference image, of the same size.
-        reference: PathBuf,
-        /// Print one JSON object instead of text.
-        #[arg(long)]
-        json: bool,
-    },
-}
 
 /// Arguments of `acr render`.
 #[derive(clap::Args, Debug)]
@@ -121,36 +78,6 @@ pub struct RenderArgs {
     /// No progress bar and no summary line.
     #[arg(long, short = 'q')]
     pub quiet: bool,
-}
-
-/// Runs the command line; returns the process exit code.
-pub fn run(cli: Cli) -> ExitCode {
-    let result = match cli.command {
-        Command::Parse { scene } => parse(&scene),
-        Command::Render(args) => render_command(&args),
-        Command::Bench { manifest, out } => bench_command(&manifest, out),
-        Command::Plugins => {
-            print!("{}", crate::registry::describe());
-            Ok(())
-        }
-        Command::Diff {
-            image,
-            reference,
-            json,
-        } => diff_command(&image, &reference, json),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => report(&e),
-    }
-}
-
-fn parse(scene: &Path) -> Result<(), String> {
-    let desc = acr_parser::parse_file(scene).map_err(|e| e.to_string())?;
-    let mut out = std::io::stdout().lock();
-    // A closed pipe (acr parse x | head) is not an error worth reporting.
-    let _ = out.write_all(desc.to_text().as_bytes());
-    Ok(())
 }
 
 /// The output path: the command line's, else the Film's filename (relative to the working
@@ -259,7 +186,8 @@ impl SamplerCostRun<'_> {
     }
 }
 
-fn render_command(args: &RenderArgs) -> Result<(), String> {
+/// Renders as `args` say.
+pub fn command(args: &RenderArgs) -> Result<(), String> {
     let t_start = Instant::now();
     if let Some(n) = args.threads {
         rayon::ThreadPoolBuilder::new()
@@ -500,76 +428,6 @@ fn render_command(args: &RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn bench_command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
-    let out = out.unwrap_or_else(|| {
-        let stem = manifest
-            .file_stem()
-            .map_or_else(|| "bench".to_owned(), |s| s.to_string_lossy().into_owned());
-        PathBuf::from("bench-out").join(stem)
-    });
-    let exe = std::env::current_exe().map_err(|e| format!("cannot find acr itself: {e}"))?;
-    let command = std::env::args().collect::<Vec<_>>().join(" ");
-    let opts = crate::bench::BenchOptions {
-        exe,
-        out: out.clone(),
-        command,
-        commit: crate::bench::commit(),
-    };
-    let results = crate::bench::run_bench(manifest, &opts)?;
-    let rows = &results.rows;
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
-    let costs = &results.costs;
-    let costs_failed = costs.iter().filter(|c| c.outcome.is_err()).count();
-    let cost_note = if costs.is_empty() {
-        String::new()
-    } else {
-        format!(
-            ", {} sampler-cost measures, {costs_failed} failed",
-            costs.len()
-        )
-    };
-    eprintln!(
-        "{} runs, {failed} failed{cost_note} -> {}",
-        rows.len(),
-        out.join("report.md").display()
-    );
-    Ok(())
-}
-
-/// A time limit in seconds: finite and positive.
-fn parse_seconds(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 && v < 1e9 => Ok(v),
-        _ => Err(format!("\"{s}\" is not a positive number of seconds")),
-    }
-}
-
-fn parse_threshold(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("\"{s}\" is not a positive relative error")),
-    }
-}
-
-fn diff_command(image: &Path, reference: &Path, json: bool) -> Result<(), String> {
-    let read = |p: &Path| {
-        crate::image_io::read_image(p, true).map_err(|e| format!("{}: {e}", p.display()))
-    };
-    let (a, b) = (read(image)?, read(reference)?);
-    let m = crate::metrics::compare(&a, &b)
-        .map_err(|e| format!("{} vs {}: {e}", image.display(), reference.display()))?;
-    if json {
-        let text = serde_json::to_string(&m).map_err(|e| e.to_string())?;
-        println!("{text}");
-    } else {
-        println!(
-            "mse {:.6e}  relmse {:.6e}  psnr {:.3} dB  mean {:.6} (reference {:.6})",
-            m.mse, m.relmse, m.psnr, m.mean, m.reference_mean
-        );
-    }
-    Ok(())
-}
-
 /// Fails early, before the render, when the output cannot be written (unknown format or a
 /// folder that does not exist), so that no render time is lost.
 fn check_writable(output: &Path) -> Result<(), String> {
@@ -595,10 +453,4 @@ fn check_writable(output: &Path) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// Prints an error the way every acr command does, and gives the failure exit code.
-pub fn report(e: &dyn std::fmt::Display) -> ExitCode {
-    eprintln!("{e}");
-    ExitCode::FAILURE
 }

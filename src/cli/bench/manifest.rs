@@ -1,0 +1,267 @@
+//! The bench manifest (TOML): scenes, methods, budgets and references, read and checked.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The manifest: scenes, methods, budgets and references.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// A title for the report.
+    #[serde(default)]
+    pub title: Option<String>,
+    /// Seed of every run.
+    #[serde(default)]
+    pub seed: u64,
+    /// Worker threads per run (default: every core).
+    #[serde(default)]
+    pub threads: Option<u32>,
+    /// Folder of cached reference renders, relative to the manifest (default `cache`).
+    #[serde(default)]
+    pub cache: Option<PathBuf>,
+    /// The budgets.
+    pub budgets: Budgets,
+    /// The reference of scenes that name none.
+    #[serde(default)]
+    pub reference: Option<Reference>,
+    /// The scenes.
+    #[serde(rename = "scene")]
+    pub scenes: Vec<SceneEntry>,
+    /// The methods; the first is the baseline of every ratio.
+    #[serde(rename = "method")]
+    pub methods: Vec<Method>,
+    /// Runs that measure the sampler's share of wall time, if any.
+    #[serde(default)]
+    pub sampler_cost: Option<SamplerCostRuns>,
+}
+
+/// The sampler's share of wall time (`acr render --sampler-cost`) of every scene and method,
+/// at some budgets: each run is its own process, and the report gives the median over them,
+/// since one process's share moves with the machine's load.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SamplerCostRuns {
+    /// Samples per pixel to measure at.
+    pub spp: Vec<u32>,
+    /// Processes per scene, method and budget.
+    #[serde(default = "five")]
+    pub runs: u32,
+}
+
+fn five() -> u32 {
+    5
+}
+
+/// Most processes per scene, method and budget in a sampler-cost measure.
+const MAX_COST_RUNS: u32 = 100;
+
+/// Samples per pixel to run at, and whether to run equal-time too.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Budgets {
+    /// Samples per pixel (equal-spp runs).
+    pub spp: Vec<u32>,
+    /// Also run every method but the first with `--time-limit` set to the first method's
+    /// render time at each budget.
+    #[serde(default = "yes")]
+    pub equal_time: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// One scene of the manifest.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneEntry {
+    /// Its label in the report.
+    pub name: String,
+    /// The .pbrt file, relative to the manifest.
+    pub path: PathBuf,
+    /// Its reference (else the manifest's).
+    #[serde(default)]
+    pub reference: Option<Reference>,
+}
+
+/// A scene's reference image: a file, or a render by one of the methods at a high budget.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged, deny_unknown_fields)]
+pub enum Reference {
+    /// A given image (EXR, PFM...), relative to the manifest.
+    Image {
+        /// The file.
+        image: PathBuf,
+    },
+    /// Rendered at `spp` by the manifest's method labelled `method`, or by the sampler,
+    /// filter, integrator and settings given here; cached.
+    Render {
+        /// A method's label.
+        #[serde(default)]
+        method: Option<String>,
+        /// `--sampler`, when no method is named.
+        #[serde(default)]
+        sampler: Option<String>,
+        /// `--filter`, when no method is named.
+        #[serde(default)]
+        filter: Option<String>,
+        /// `--integrator`, when no method is named.
+        #[serde(default)]
+        integrator: Option<String>,
+        /// `--set` settings, when no method is named.
+        #[serde(default)]
+        set: Vec<String>,
+        /// Samples per pixel.
+        spp: u32,
+    },
+}
+
+impl Reference {
+    /// The method a rendered reference uses.
+    pub(super) fn method(&self, methods: &[Method]) -> Result<Option<Method>, String> {
+        match self {
+            Reference::Image { .. } => Ok(None),
+            Reference::Render {
+                method: Some(label),
+                ..
+            } => methods
+                .iter()
+                .find(|m| &m.label == label)
+                .cloned()
+                .map(Some)
+                .ok_or_else(|| format!("names method \"{label}\", which is not listed")),
+            Reference::Render {
+                method: None,
+                sampler,
+                filter,
+                integrator,
+                set,
+                ..
+            } => Ok(Some(Method {
+                label: "reference".to_owned(),
+                sampler: sampler.clone(),
+                filter: filter.clone(),
+                integrator: integrator.clone(),
+                set: set.clone(),
+            })),
+        }
+    }
+}
+
+/// A sampler + filter (+ integrator) with parameters, under a label.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Method {
+    /// Its name in the report (`stratified+box`).
+    pub label: String,
+    /// `--sampler` (default: the scene's).
+    #[serde(default)]
+    pub sampler: Option<String>,
+    /// `--filter` (default: the scene's).
+    #[serde(default)]
+    pub filter: Option<String>,
+    /// `--integrator` (default: the scene's).
+    #[serde(default)]
+    pub integrator: Option<String>,
+    /// `--set KIND.PARAM=VALUE` settings.
+    #[serde(default)]
+    pub set: Vec<String>,
+}
+
+/// How a run was budgeted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// At a number of samples per pixel.
+    EqualSpp,
+    /// At the first method's time for that number of samples per pixel.
+    EqualTime,
+}
+
+impl Mode {
+    pub(super) fn name(self) -> &'static str {
+        match self {
+            Mode::EqualSpp => "equal-spp",
+            Mode::EqualTime => "equal-time",
+        }
+    }
+}
+
+/// Reads and checks a manifest.
+pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let m: Manifest = toml::from_str(&text).map_err(|e| {
+        let (line, col) = e.span().map_or((1, 1), |s| line_col(&text, s.start));
+        format!("{}:{line}:{col}: {}", path.display(), e.message())
+    })?;
+    if m.methods.is_empty() || m.scenes.is_empty() || m.budgets.spp.is_empty() {
+        return Err(format!(
+            "{}: a manifest needs at least one [[scene]], one [[method]] and one budget",
+            path.display()
+        ));
+    }
+    if let Some(&bad) = m
+        .budgets
+        .spp
+        .iter()
+        .find(|&&s| s == 0 || s > crate::render::MAX_SPP)
+    {
+        return Err(format!(
+            "{}: budget {bad} spp is out of range",
+            path.display()
+        ));
+    }
+    if let Some(c) = &m.sampler_cost {
+        if let Some(&bad) = c
+            .spp
+            .iter()
+            .find(|&&s| s == 0 || s > crate::render::MAX_SPP)
+        {
+            return Err(format!(
+                "{}: sampler_cost budget {bad} spp is out of range",
+                path.display()
+            ));
+        }
+        if c.runs == 0 || c.runs > MAX_COST_RUNS {
+            return Err(format!(
+                "{}: sampler_cost runs {} is out of range (1 to {MAX_COST_RUNS})",
+                path.display(),
+                c.runs
+            ));
+        }
+    }
+    let mut labels = std::collections::HashSet::new();
+    for meth in &m.methods {
+        if !labels.insert(meth.label.as_str()) {
+            return Err(format!(
+                "{}: method \"{}\" is listed twice",
+                path.display(),
+                meth.label
+            ));
+        }
+    }
+    for s in &m.scenes {
+        let Some(r) = s.reference.as_ref().or(m.reference.as_ref()) else {
+            return Err(format!(
+                "{}: scene \"{}\" has no reference (give it one, or a top-level one)",
+                path.display(),
+                s.name
+            ));
+        };
+        r.method(&m.methods).map_err(|e| {
+            format!(
+                "{}: the reference of scene \"{}\" {e}",
+                path.display(),
+                s.name
+            )
+        })?;
+    }
+    Ok(m)
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, col)
+}

@@ -1,0 +1,184 @@
+//! Building a scene's lights from their pbrt-v3 descriptions: `LightSource` directives, and the
+//! parameters area lights share with them.
+
+use super::Builder;
+use crate::geometry::{Spectrum, Vec3};
+use crate::light::{spot_frame, EnvMap, Light};
+use crate::light_image::LightImage;
+use acr_parser::{Error, ParamList, ParamType, PluginDesc, Result};
+use glam::DMat4;
+use std::path::Path;
+use std::sync::Arc;
+
+impl Builder<'_> {
+    pub(super) fn light(
+        &mut self,
+        p: &PluginDesc,
+        world_from_light: &DMat4,
+        world_radius: f32,
+        main_dir: &Path,
+    ) -> Result<Option<Light>> {
+        let params = &p.params;
+        let scale = rgb_param(params, "scale", Spectrum::ONE)?;
+        let m = world_from_light.as_mat4();
+        Ok(Some(match p.kind.as_str() {
+            "point" => {
+                let from = vec3_param(params, "from", Vec3::ZERO)?;
+                Light::Point {
+                    pos: m.transform_point3(from),
+                    intensity: rgb_param(params, "I", Spectrum::ONE)? * scale,
+                }
+            }
+            "spot" => {
+                let from = vec3_param(params, "from", Vec3::ZERO)?;
+                let to = vec3_param(params, "to", Vec3::Z)?;
+                let cone = params.float_or("coneangle", 30.0)? as f32;
+                let delta = params.float_or("conedeltaangle", 5.0)? as f32;
+                let pos = m.transform_point3(from);
+                let dir = m.transform_vector3(to - from).normalize_or_zero();
+                if dir == Vec3::ZERO {
+                    return Err(Error::at(
+                        &p.loc,
+                        "spot light: \"from\" and \"to\" coincide",
+                    ));
+                }
+                Light::Spot {
+                    pos,
+                    light_from_world: spot_frame(dir),
+                    intensity: rgb_param(params, "I", Spectrum::ONE)? * scale,
+                    cos_total: cone.to_radians().cos(),
+                    cos_falloff_start: (cone - delta).to_radians().cos(),
+                }
+            }
+            "distant" => {
+                let from = vec3_param(params, "from", Vec3::ZERO)?;
+                let to = vec3_param(params, "to", Vec3::Z)?;
+                let w = m.transform_vector3(from - to).normalize_or_zero();
+                if w == Vec3::ZERO {
+                    return Err(Error::at(
+                        &p.loc,
+                        "distant light: \"from\" and \"to\" coincide",
+                    ));
+                }
+                Light::Distant {
+                    w,
+                    radiance: rgb_param(params, "L", Spectrum::ONE)? * scale,
+                    world_radius,
+                }
+            }
+            "infinite" | "exinfinite" => {
+                let l = rgb_param(params, "L", Spectrum::ONE)? * scale;
+                let map = match params.string("mapname")? {
+                    Some(name) if !name.is_empty() => {
+                        let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
+                        let path = crate::texture::resolve_file(name, loc, main_dir);
+                        let img = crate::image_io::read_image(&path, false)
+                            .map_err(|e| Error::at(loc, format!("cannot read \"{name}\": {e}")))?;
+                        Some(EnvMap::new(Arc::new(img)))
+                    }
+                    // pbrt-v3 gives a constant environment a 1x1 map and samples it through
+                    // the map's distribution (uniform in (phi, theta), denser at the poles);
+                    // doing the same keeps the variance, and the spatial light choice, as
+                    // pbrt-v3 has them.
+                    _ => Some(EnvMap::new(Arc::new(crate::image_io::RgbImage {
+                        width: 1,
+                        height: 1,
+                        pixels: vec![Spectrum::ONE],
+                    }))),
+                };
+                Light::Infinite {
+                    l,
+                    map,
+                    light_from_world: m.inverse(),
+                    world_from_light: m,
+                    world_radius,
+                }
+            }
+            "goniometric" | "projection" => {
+                let intensity = rgb_param(params, "I", Spectrum::ONE)? * scale;
+                // pbrt-v3 reads the image with ReadImage: PNG values as stored, no sRGB
+                // decoding. Without "mapname" it has no image (and emits I unscaled); acr
+                // makes an unreadable one an error where pbrt-v3 goes on without it.
+                let map = match params.string("mapname")? {
+                    Some(name) if !name.is_empty() => {
+                        let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
+                        let path = crate::texture::resolve_file(name, loc, main_dir);
+                        let img = crate::image_io::read_image(&path, false)
+                            .map_err(|e| Error::at(loc, format!("cannot read \"{name}\": {e}")))?;
+                        Some(
+                            LightImage::new(&img).ok_or_else(|| {
+                                Error::at(loc, format!("\"{name}\" has no pixels"))
+                            })?,
+                        )
+                    }
+                    _ => None,
+                };
+                let light = if p.kind == "goniometric" {
+                    Light::goniometric(world_from_light, intensity, map)
+                } else {
+                    let fov = params.float_or("fov", 45.0)? as f32;
+                    Light::projection(world_from_light, intensity, map, fov)
+                };
+                light.map_err(|e| Error::at(&p.loc, format!("{} light: {e}", p.kind)))?
+            }
+            other => {
+                let kinds = [
+                    "point",
+                    "spot",
+                    "goniometric",
+                    "projection",
+                    "distant",
+                    "infinite",
+                ];
+                let hint = acr_parser::closest(other, kinds)
+                    .map_or(String::new(), |k| format!(" (did you mean {k}?)"));
+                return Err(Error::at(
+                    &p.loc,
+                    format!("unknown light \"{other}\"{hint}"),
+                ));
+            }
+        }))
+    }
+}
+
+/// Most shadow samples a light may ask for per shading point.
+const MAX_LIGHT_SAMPLES: i32 = 4096;
+
+/// An area or infinite light's shadow samples per shading point: pbrt-v3's
+/// `FindOneInt("samples", FindOneInt("nsamples", 1))`; below 1 counts as 1 (pbrt-v3 then takes
+/// one sample), above [`MAX_LIGHT_SAMPLES`] is an error at the parameter.
+pub(super) fn light_sample_count(params: &ParamList) -> Result<u32> {
+    let nsamples = params.int_or("nsamples", 1)?;
+    let n = params.int_or("samples", nsamples)?;
+    if n > MAX_LIGHT_SAMPLES {
+        let name = if params.get("samples").is_some() {
+            "samples"
+        } else {
+            "nsamples"
+        };
+        let loc = &params.get(name).expect("given").loc;
+        return Err(Error::at(
+            loc,
+            format!("{name} {n} is more than {MAX_LIGHT_SAMPLES} shadow samples per point"),
+        ));
+    }
+    Ok(n.max(1) as u32)
+}
+
+/// An RGB-valued parameter (rgb, spectrum or blackbody) or its default.
+pub fn rgb_param(params: &ParamList, name: &str, default: Spectrum) -> Result<Spectrum> {
+    Ok(crate::texture::spectrum_value(params, name)?.unwrap_or(default))
+}
+
+fn vec3_param(params: &ParamList, name: &str, default: Vec3) -> Result<Vec3> {
+    let Some(p) = params.get(name) else {
+        return Ok(default);
+    };
+    let v = match p.ty {
+        ParamType::Point3 | ParamType::Vector3 | ParamType::Normal => params.vec3(name, p.ty)?,
+        _ => return Err(Error::at(&p.loc, format!("\"{name}\" must be a point3"))),
+    };
+    Ok(v.map_or(default, |a| {
+        Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    }))
+}

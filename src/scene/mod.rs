@@ -1,0 +1,439 @@
+//! The renderable scene, built once from a [`SceneDescription`]: camera, film settings,
+//! acceleration structure, lights, materials, and which dimensions the rendering space needs.
+
+use crate::accel::{Accel, Geometry, Instance, Placement, PrimKind};
+use crate::camera::Camera;
+use crate::film::FilmSettings;
+use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3};
+use crate::light::{prim_area, AreaShape, Light};
+use crate::lightbvh::{LightBvh, LightContext};
+use crate::lightdistrib::{LightDistribution, LightPmf, LightStrategy};
+use crate::material::Material;
+use crate::transform::MotionTransform;
+use acr_parser::{Error, PluginDesc, Result, SceneDescription, Warning};
+use glam::DMat4;
+use std::collections::HashSet;
+use std::sync::{Arc, OnceLock};
+
+mod lights;
+mod shapes;
+
+use lights::light_sample_count;
+pub use lights::rgb_param;
+
+/// What a primitive's surface is: its material and the area light it carries.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Surface {
+    /// Index into [`Scene::materials`]; `None` for an interface (`Material ""`).
+    pub material: Option<u32>,
+    /// Index into [`Scene::lights`] when the primitive emits.
+    pub area_light: Option<u32>,
+}
+
+pub use acr_plugins::Dims;
+
+/// A scene ready to render.
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Film settings.
+    pub film: FilmSettings,
+    /// The acceleration structure.
+    pub accel: Accel,
+    /// Every light.
+    pub lights: Vec<Light>,
+    /// Shadow samples per light per shading point for `directlighting`'s "all" strategy (the
+    /// area and infinite lights' `nsamples`, pbrt-v3's; 1 for the others).
+    pub light_samples: Vec<u32>,
+    /// Light choice for next-event estimation, one per strategy (spatial built on first use).
+    light_choice: LightChoices,
+    /// Indices of infinite lights (seen by rays that escape).
+    pub infinite_lights: Vec<u32>,
+    /// Materials by index.
+    pub materials: Vec<Material>,
+    /// Surfaces by index.
+    pub surfaces: Vec<Surface>,
+    /// Active dimensions of the rendering space.
+    pub dims: Dims,
+    /// Centre of the scene's bounding sphere.
+    pub world_center: Vec3,
+    /// Radius of the scene's bounding sphere.
+    pub world_radius: f32,
+    /// Render space from world space: everything the scene holds (geometry, lights, camera,
+    /// textures) is in render space, the world translated so that the camera sits at the
+    /// origin (pbrt-v4's "camera-world" space). f32 resolution is finest near the origin, so a
+    /// scene far from the world origin renders as precisely as one at it.
+    pub render_from_world: DMat4,
+}
+
+/// A ray's closest hit, resolved.
+pub struct SceneHit {
+    /// Where it hit.
+    pub si: SurfaceInteraction,
+    /// What it hit.
+    pub surface: Surface,
+}
+
+impl Scene {
+    /// The closest hit along the ray, if any.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<SceneHit> {
+        let hit = self.accel.intersect(ray, f32::INFINITY)?;
+        let si = self.accel.interaction(ray, &hit);
+        Some(SceneHit {
+            si,
+            surface: self.surfaces[hit.prim.surface as usize],
+        })
+    }
+
+    /// Whether the segment from `si` to `target` is blocked.
+    #[inline]
+    pub fn occluded(&self, si: &SurfaceInteraction, target: Vec3) -> bool {
+        let (ray, t_max) = si.spawn_ray_to(target);
+        self.accel.occluded(&ray, t_max)
+    }
+
+    /// Chooses a light for next-event estimation at `ctx` under `strategy` with `u` in
+    /// [0, 1): its index and probability; `None` when the strategy finds no light that can
+    /// reach the point.
+    #[inline]
+    pub fn choose_light(
+        &self,
+        strategy: LightStrategy,
+        ctx: LightContext,
+        u: f32,
+    ) -> Option<(usize, f32)> {
+        match strategy {
+            LightStrategy::Bvh => self.light_bvh().sample(ctx, u),
+            _ => {
+                let pmf = self.light_pmf(strategy, ctx.p);
+                (!pmf.is_empty()).then(|| pmf.sample(u))
+            }
+        }
+    }
+
+    /// Probability that [`Scene::choose_light`] at `ctx` under `strategy` picks `light`.
+    #[inline]
+    pub fn light_choice_pdf(
+        &self,
+        strategy: LightStrategy,
+        ctx: LightContext,
+        light: usize,
+    ) -> f32 {
+        match strategy {
+            LightStrategy::Bvh => self.light_bvh().pmf(ctx, light),
+            _ => self.light_pmf(strategy, ctx.p).pdf(light),
+        }
+    }
+
+    /// The light BVH (built on first use).
+    pub fn light_bvh(&self) -> &LightBvh {
+        self.light_choice
+            .bvh
+            .get_or_init(|| LightBvh::new(&self.lights, &self.accel.world))
+    }
+
+    /// The distribution to choose a light from at `p` under a strategy other than `bvh`.
+    #[inline]
+    fn light_pmf(&self, strategy: LightStrategy, p: Vec3) -> &LightPmf {
+        let c = &self.light_choice;
+        match strategy {
+            LightStrategy::Uniform => &c.uniform,
+            // `Bvh` never comes here (choose_light and light_choice_pdf ask the tree).
+            LightStrategy::Power | LightStrategy::Bvh => &c.power,
+            LightStrategy::Spatial => c
+                .spatial
+                .get_or_init(|| LightDistribution::new(strategy, &self.lights, c.bounds))
+                .lookup(p, &self.lights, &self.accel.world),
+        }
+    }
+}
+
+/// The light distributions of a scene.
+struct LightChoices {
+    uniform: LightPmf,
+    power: LightPmf,
+    spatial: OnceLock<LightDistribution>,
+    bvh: OnceLock<LightBvh>,
+    bounds: (Vec3, Vec3),
+}
+
+/// Builds scenes, collecting warnings.
+struct Builder<'a> {
+    desc: &'a SceneDescription,
+    warnings: &'a mut Vec<Warning>,
+    warned: HashSet<String>,
+    surfaces: Vec<Surface>,
+    lights: Vec<Light>,
+    light_samples: Vec<u32>,
+    /// Area lights waiting for the world's bounds: (light description, surface index).
+    area_lights: Vec<(Arc<PluginDesc>, PrimKind, u32)>,
+}
+
+impl Builder<'_> {
+    fn warn_once(&mut self, key: String, loc: &acr_parser::Loc, msg: String) {
+        if self.warned.insert(key) {
+            self.warnings.push(Warning::at(loc, msg));
+        }
+    }
+
+    fn surface(&mut self, s: Surface) -> u32 {
+        self.surfaces.push(s);
+        (self.surfaces.len() - 1) as u32
+    }
+}
+
+/// The translation that takes the camera's position (at its start transform) to the origin.
+/// Exact in f64; a camera description that cannot be inverted gives the identity. A camera
+/// beyond the range of 32-bit floats is an error: nothing could be placed relative to it.
+fn render_from_world(camera: &acr_parser::CameraDesc) -> Result<DMat4> {
+    let camera_pos = camera
+        .camera_from_world
+        .start
+        .inverse()
+        .transform_point3(glam::DVec3::ZERO);
+    if !camera_pos.is_finite() {
+        return Ok(DMat4::IDENTITY);
+    }
+    if camera_pos.abs().max_element() > f64::from(f32::MAX) {
+        return Err(Error::at(
+            &camera.plugin.loc,
+            format!(
+                "the camera stands at ({:.3e}, {:.3e}, {:.3e}), beyond the range of 32-bit \
+                 floats (3.4e38); move the scene nearer the origin",
+                camera_pos.x, camera_pos.y, camera_pos.z
+            ),
+        ));
+    }
+    Ok(DMat4::from_translation(-camera_pos))
+}
+
+impl Scene {
+    /// Builds the scene from its description. Warnings (unsupported features, unused
+    /// parameters) are appended to `warnings`.
+    pub fn build(desc: &SceneDescription, warnings: &mut Vec<Warning>) -> Result<Scene> {
+        let main_dir = desc
+            .files
+            .first()
+            .map(|f| f.dir().to_path_buf())
+            .unwrap_or_default();
+        let Some(camera_desc) = &desc.camera else {
+            let path = desc
+                .files
+                .first()
+                .map(|f| f.path.clone())
+                .unwrap_or_default();
+            return Err(Error::file(path, "the scene has no Camera"));
+        };
+        let film = FilmSettings::new(desc.film.as_ref())?;
+        let render_from_world = render_from_world(camera_desc)?;
+        let in_render = |t: &acr_parser::AnimatedTransform| acr_parser::AnimatedTransform {
+            start: render_from_world * t.start,
+            end: render_from_world * t.end,
+            ..*t
+        };
+        let camera = Camera::new(camera_desc, film.resolution, render_from_world)?;
+        let mut b = Builder {
+            desc,
+            warnings,
+            warned: HashSet::new(),
+            surfaces: Vec::new(),
+            lights: Vec::new(),
+            light_samples: Vec::new(),
+            area_lights: Vec::new(),
+        };
+        let mut accel = Accel::default();
+        let mut world = Geometry::default();
+        for shape in &desc.shapes {
+            let moving = shape.world_from_object.is_animated()
+                && shape.world_from_object.end_time > shape.world_from_object.start_time;
+            if moving {
+                if let Some(al) = &shape.area_light {
+                    b.warn_once(
+                        "moving area light".into(),
+                        &al.loc,
+                        "area lights on moving shapes are not supported (as in pbrt-v3); \
+                         the shape does not emit"
+                            .into(),
+                    );
+                }
+                let mut g = Geometry::default();
+                b.add_shape(&mut g, shape, &DMat4::IDENTITY, false)?;
+                accel.objects.push(g);
+                accel.instances.push(Instance {
+                    object: (accel.objects.len() - 1) as u32,
+                    placement: Placement::Moving(Box::new(MotionTransform::new(&in_render(
+                        &shape.world_from_object,
+                    )))),
+                });
+            } else {
+                let m = render_from_world * shape.world_from_object.start;
+                b.add_shape(&mut world, shape, &m, true)?;
+            }
+        }
+        let first_object = accel.objects.len() as u32;
+        for object in b.desc.objects.values() {
+            let mut g = Geometry::default();
+            for shape in &object.shapes {
+                if shape.world_from_object.is_animated() {
+                    b.warn_once(
+                        "animated in object".into(),
+                        &shape.plugin.loc,
+                        "motion inside an object definition is not supported; the shape is \
+                         placed at its start transform (move the instance instead)"
+                            .into(),
+                    );
+                }
+                b.add_shape(&mut g, shape, &shape.world_from_object.start, false)?;
+            }
+            accel.objects.push(g);
+        }
+        for inst in &desc.instances {
+            let t = &in_render(&inst.world_from_instance);
+            let placement = if t.is_animated() && t.end_time > t.start_time {
+                Placement::Moving(Box::new(MotionTransform::new(t)))
+            } else {
+                Placement::Fixed {
+                    to_world: t.start.as_mat4(),
+                    to_local: t.start.inverse().as_mat4(),
+                }
+            };
+            accel.instances.push(Instance {
+                object: first_object + inst.object as u32,
+                placement,
+            });
+        }
+        accel.world = world;
+        let dropped = accel.build();
+        if dropped > 0 {
+            b.warnings.push(Warning {
+                loc: None,
+                message: format!(
+                    "{dropped} object instances are placed beyond the range of 32-bit floats \
+                     and are skipped"
+                ),
+            });
+        }
+        let (lo, hi) = accel.bounds();
+        let (world_center, world_radius) = if lo.cmple(hi).all() {
+            ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+        } else {
+            (Vec3::ZERO, 1.0)
+        };
+        // Area lights, now that the world geometry has its final layout.
+        for (light, kind, surface) in std::mem::take(&mut b.area_lights) {
+            if !matches!(light.kind.as_str(), "area" | "diffuse") {
+                return Err(Error::at(
+                    &light.loc,
+                    format!(
+                        "area light \"{}\" is not supported (only \"diffuse\")",
+                        light.kind
+                    ),
+                ));
+            }
+            let params = &light.params;
+            let l_emit =
+                rgb_param(params, "L", Spectrum::ONE)? * rgb_param(params, "scale", Spectrum::ONE)?;
+            let two_sided = params.bool_or("twosided", false)?;
+            let samples = light_sample_count(params)?;
+            let area = prim_area(&accel.world, kind);
+            if area > 0.0 && l_emit.max_element() > 0.0 {
+                b.lights.push(Light::Area {
+                    shape: AreaShape { kind },
+                    l_emit,
+                    two_sided,
+                    area,
+                });
+                b.light_samples.push(samples);
+                b.surfaces[surface as usize].area_light = Some((b.lights.len() - 1) as u32);
+            }
+        }
+        for l in &desc.lights {
+            if let Some(light) = b.light(
+                &l.plugin,
+                &(render_from_world * l.world_from_light),
+                world_radius,
+                &main_dir,
+            )? {
+                let samples = match light {
+                    Light::Infinite { .. } => light_sample_count(&l.plugin.params)?,
+                    _ => 1,
+                };
+                b.lights.push(light);
+                b.light_samples.push(samples);
+            }
+        }
+        let materials =
+            crate::material::build_materials(desc, &main_dir, render_from_world, b.warnings)?;
+        let powers: Vec<f32> = b
+            .lights
+            .iter()
+            .map(|l| crate::spectrum_luminance(l.power()))
+            .collect();
+        let infinite_lights = b
+            .lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| matches!(l, Light::Infinite { .. }))
+            .map(|(i, _)| i as u32)
+            .collect();
+        let dims = Dims {
+            time: (accel.has_motion() || camera.is_moving())
+                && camera.shutter_close > camera.shutter_open,
+            lens: camera.lens_radius > 0.0,
+        };
+        Ok(Scene {
+            camera,
+            film,
+            accel,
+            light_choice: LightChoices {
+                uniform: LightPmf::new(&vec![1.0; powers.len()]),
+                power: LightPmf::new(&powers),
+                spatial: OnceLock::new(),
+                bvh: OnceLock::new(),
+                bounds: (lo, hi),
+            },
+            lights: b.lights,
+            light_samples: b.light_samples,
+            infinite_lights,
+            materials,
+            surfaces: b.surfaces,
+            dims,
+            world_center,
+            world_radius,
+            render_from_world,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// pbrt-v3's spot light reads its falloff from "conedeltaangle" (default 5 degrees).
+    #[test]
+    fn a_spot_light_falls_off_over_conedeltaangle() {
+        for (param, delta) in [("\"float conedeltaangle\" 12", 12.0f32), ("", 5.0)] {
+            let text = format!(
+                "Camera \"perspective\"\nWorldBegin\nLightSource \"spot\" \
+                 \"float coneangle\" 40 {param}\nShape \"sphere\"\nWorldEnd"
+            );
+            let desc = acr_parser::parse_str(&text, Path::new("spot.pbrt")).unwrap();
+            let mut warnings = Vec::new();
+            let scene = Scene::build(&desc, &mut warnings).unwrap();
+            let Some(Light::Spot {
+                cos_total,
+                cos_falloff_start,
+                ..
+            }) = scene.lights.first()
+            else {
+                panic!("no spot light");
+            };
+            assert!((cos_total - 40f32.to_radians().cos()).abs() < 1e-6);
+            let expected = (40.0 - delta).to_radians().cos();
+            assert!((cos_falloff_start - expected).abs() < 1e-6, "{param}");
+            assert!(desc.unused_parameter_warnings().is_empty(), "{param}");
+        }
+    }
+}
