@@ -255,6 +255,68 @@ fn parse_pfm(data: &[u8]) -> Result<RgbImage, String> {
 /// Writes an image, choosing the format by extension: `.exr` (linear 32-bit float RGB), `.png`
 /// (8-bit sRGB: clamped to [0, 1], encoded, rounded, as pbrt-v3 writes it) or `.pfm` (linear
 /// 32-bit float RGB, little-endian).
+/// Where an image lies in a larger frame: a crop of a `width` x `height` image whose top-left
+/// pixel is (`x0`, `y0`). An EXR carries it as its display window (the frame) and data window
+/// (the crop), as OpenEXR and pbrt-v4 do, so that an assembler can place the crop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frame {
+    /// The whole image's width.
+    pub width: usize,
+    /// The whole image's height.
+    pub height: usize,
+    /// The crop's first column.
+    pub x0: usize,
+    /// The crop's first row.
+    pub y0: usize,
+}
+
+/// Writes `img`, a crop placed in `frame` (EXR keeps the placement; PNG and PFM hold the crop
+/// alone).
+pub fn write_image_in_frame(path: &Path, img: &RgbImage, frame: Frame) -> Result<(), String> {
+    if extension(path) == "exr" && img.pixels.len() == img.width * img.height {
+        return write_exr_in(path, img, Some(frame));
+    }
+    write_image(path, img)
+}
+
+/// Reads an EXR and where it lies in its frame (its data window within its display window);
+/// other formats are their own frame.
+pub fn read_image_with_frame(path: &Path) -> Result<(RgbImage, Frame), String> {
+    let img = read_image(path, false)?;
+    let mut frame = Frame {
+        width: img.width,
+        height: img.height,
+        x0: 0,
+        y0: 0,
+    };
+    if extension(path) == "exr" {
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+        if let Some(h) = meta.headers.first() {
+            let display = h.shared_attributes.display_window;
+            let pos = h.own_attributes.layer_position;
+            let (dx, dy) = (
+                pos.x() - display.position.x(),
+                pos.y() - display.position.y(),
+            );
+            if dx < 0 || dy < 0 {
+                return Err(format!(
+                    "its data window starts outside its display window ({dx}, {dy})"
+                ));
+            }
+            frame = Frame {
+                width: display.size.width(),
+                height: display.size.height(),
+                x0: dx as usize,
+                y0: dy as usize,
+            };
+        }
+    }
+    if frame.x0 + img.width > frame.width || frame.y0 + img.height > frame.height {
+        return Err("its data window reaches beyond its display window".to_owned());
+    }
+    Ok((img, frame))
+}
+
 pub fn write_image(path: &Path, img: &RgbImage) -> Result<(), String> {
     if img.pixels.len() != img.width * img.height {
         return Err(format!(
@@ -275,6 +337,12 @@ pub fn write_image(path: &Path, img: &RgbImage) -> Result<(), String> {
 }
 
 fn write_exr(path: &Path, img: &RgbImage) -> Result<(), String> {
+    write_exr_in(path, img, None)
+}
+
+/// An EXR of `img`, placed in `frame` when given (display window the frame, data window the
+/// crop).
+fn write_exr_in(path: &Path, img: &RgbImage, frame: Option<Frame>) -> Result<(), String> {
     use exr::prelude::*;
     // Tiles are compressed on several threads; an increasing line order makes the writer put
     // them in the file in order, so the bytes do not depend on which thread finishes first
@@ -287,7 +355,19 @@ fn write_exr(path: &Path, img: &RgbImage) -> Result<(), String> {
         let c = img.get(x, y);
         (c.x, c.y, c.z)
     });
-    Image::from_encoded_channels((img.width, img.height), encoding, channels)
+    let Some(f) = frame else {
+        return Image::from_encoded_channels((img.width, img.height), encoding, channels)
+            .write()
+            .to_file(path)
+            .map_err(|e| e.to_string());
+    };
+    let attributes = LayerAttributes {
+        layer_position: Vec2(f.x0 as i32, f.y0 as i32),
+        ..LayerAttributes::default()
+    };
+    let layer = Layer::new((img.width, img.height), attributes, encoding, channels);
+    let display = IntegerBounds::new((0, 0), (f.width, f.height));
+    Image::new(ImageAttributes::new(display), layer)
         .write()
         .to_file(path)
         .map_err(|e| e.to_string())

@@ -111,11 +111,11 @@ fn resolve<'a, B>(
 /// Chooses and builds the sampler, filter and integrator: the scene's directives, with the
 /// command line's names and settings on top. Without a directive, pbrt-v3's defaults: the
 /// `halton` sampler at 16 spp, the `box` filter and the `path` integrator. The sampler's
-/// setup says whether the chosen filter reads its cells.
+/// setup says whether the chosen filter reads its cells, and gets the filter's radius.
 pub fn choose(
     desc: &SceneDescription,
     overrides: &Overrides,
-    setup: impl FnOnce() -> SamplerSetup,
+    setup: impl Fn((f32, f32)) -> SamplerSetup,
     warnings: &mut Vec<Warning>,
 ) -> Result<Plugins> {
     let mut ic = Choice::new(
@@ -137,11 +137,17 @@ pub fn choose(
         overrides.sampler.as_deref(),
     );
     let se: &Entry<SamplerBuild> = resolve(SAMPLERS, Kind::Sampler, &mut sc, overrides, warnings)?;
-    let setup = SamplerSetup {
-        reconstruction_reads_cells: filter.cell_layout().is_some(),
-        ..setup()
+    let reads_cells = filter.cell_layout().is_some();
+    let setup = |radius| SamplerSetup {
+        reconstruction_reads_cells: reads_cells,
+        ..setup(radius)
     };
-    let sampler = (se.build)(&sc, &setup)?;
+    let mut sampler = (se.build)(&sc, &setup((0.0, 0.0)))?;
+    if !reads_cells && !sampler.reconstructs() {
+        // A splatting filter: sample the crop widened by its radius, so that crops tile the
+        // frame. Reconstructions over cells keep to the crop (their cells cover it alone).
+        sampler = (se.build)(&sc, &setup(filter.kernel().radius()))?;
+    }
     if sampler.reconstructs() {
         // The method's reconstruction is part of it: a filter asked for is not used.
         let named = overrides
@@ -177,8 +183,8 @@ pub fn choose(
     })
 }
 
-/// [`choose`] for a built scene: the sampler covers the scene's rendering space, with the
-/// command line's `spp` (if any) and `seed`.
+/// [`choose`] for a built scene: the sampler covers the scene's crop widened by the filter's
+/// radius ([`crate::render::sample_space`]), with the command line's `spp` (if any) and `seed`.
 pub fn choose_for_scene(
     desc: &SceneDescription,
     scene: &crate::scene::Scene,
@@ -187,8 +193,8 @@ pub fn choose_for_scene(
     seed: u64,
     warnings: &mut Vec<Warning>,
 ) -> Result<Plugins> {
-    let setup = || SamplerSetup {
-        space: crate::render::rendering_space(scene),
+    let setup = |radius| SamplerSetup {
+        space: crate::render::sample_space(scene, radius),
         spp,
         seed,
         // `choose` sets it from the filter it chooses.

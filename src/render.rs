@@ -28,6 +28,31 @@ pub fn rendering_space(scene: &Scene) -> RenderingSpace {
     }
 }
 
+/// The pixels a render samples: the film's crop widened by the filter's radius, as pbrt-v3's
+/// `Film::GetSampleBounds` widens it (floor(x0 + 0.5 - r) to ceil(x1 - 0.5 + r)), so that a
+/// crop's edge pixels receive the same samples' splats as in a render of the whole frame and
+/// crops tile the frame exactly. Kept within the image: acr samples no pixel outside it (a
+/// whole-frame render samples exactly its pixels).
+pub fn sample_space(scene: &Scene, radius: (f32, f32)) -> RenderingSpace {
+    let crop = rendering_space(scene);
+    let (w, h) = scene.film.resolution;
+    let widen = |lo: u32, hi: u32, r: f32, size: u32| {
+        let r = if r.is_finite() { r.max(0.0) } else { 0.0 };
+        let a = (lo as f32 + 0.5 - r).floor().max(0.0) as u32;
+        let b = (hi as f32 - 0.5 + r).ceil().min(size as f32) as u32;
+        (a.min(lo), b.max(hi))
+    };
+    let (x0, x1) = widen(crop.x0, crop.x1, radius.0, w);
+    let (y0, y1) = widen(crop.y0, crop.y1, radius.1, h);
+    RenderingSpace {
+        x0,
+        x1,
+        y0,
+        y1,
+        dims: crop.dims,
+    }
+}
+
 /// The raster position of offset `u` in [0, 1)^2 within pixel (px, py). Rounding can carry
 /// `py + u.y` to `py + 1` (from row 1024 on, say); the result is kept inside the pixel, so that
 /// a sample always lands in the pixel it was drawn for and batches stay sorted by row.

@@ -69,21 +69,10 @@ impl FilmSettings {
         let mut s = Self::with_resolution(res("xresolution", 1280)?, res("yresolution", 720)?);
         if let Some(c) = params.floats("cropwindow")? {
             let loc = params.get("cropwindow").map_or(&p.loc, |x| &x.loc).clone();
-            let [x0, x1, y0, y1] = <[f64; 4]>::try_from(c)
+            let window = <[f64; 4]>::try_from(c)
                 .map_err(|_| Error::at(&loc, "\"cropwindow\" needs four values"))?;
-            let (x0, x1) = (x0.clamp(0.0, 1.0), x1.clamp(0.0, 1.0));
-            let (y0, y1) = (y0.clamp(0.0, 1.0), y1.clamp(0.0, 1.0));
-            let (w, h) = (s.resolution.0 as f64, s.resolution.1 as f64);
-            // pbrt-v3: ceil of the crop window in raster space.
-            s.crop = [
-                (w * x0.min(x1)).ceil() as u32,
-                (w * x0.max(x1)).ceil() as u32,
-                (h * y0.min(y1)).ceil() as u32,
-                (h * y0.max(y1)).ceil() as u32,
-            ];
-            if s.crop[0] >= s.crop[1] || s.crop[2] >= s.crop[3] {
-                return Err(Error::at(&loc, "\"cropwindow\" contains no pixel"));
-            }
+            s.set_crop_window(window)
+                .map_err(|e| Error::at(&loc, format!("\"cropwindow\" {e}")))?;
         }
         s.filename = params.string("filename")?.map(str::to_owned);
         s.scale = params.float_or("scale", 1.0)? as f32;
@@ -112,6 +101,41 @@ impl FilmSettings {
         // Accepted, and meaningless for an RGB film.
         let _ = params.float("diagonal")?;
         Ok(s)
+    }
+
+    /// Crops to a window given in fractions of the image, [x0, x1, y0, y1] (pbrt-v3's
+    /// `cropwindow`: the ceiling of each edge in raster space; values clamped to [0, 1]).
+    pub fn set_crop_window(&mut self, window: [f64; 4]) -> std::result::Result<(), String> {
+        let [x0, x1, y0, y1] = window.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) });
+        let (w, h) = (self.resolution.0 as f64, self.resolution.1 as f64);
+        self.set_pixel_bounds([
+            (w * x0.min(x1)).ceil() as u32,
+            (w * x0.max(x1)).ceil() as u32,
+            (h * y0.min(y1)).ceil() as u32,
+            (h * y0.max(y1)).ceil() as u32,
+        ])
+    }
+
+    /// Crops to the pixels [x0, x1) x [y0, y1) (pbrt-v4's `--pixelbounds`), which must lie in
+    /// the image and hold at least one pixel.
+    pub fn set_pixel_bounds(&mut self, bounds: [u32; 4]) -> std::result::Result<(), String> {
+        let [x0, x1, y0, y1] = bounds;
+        let (w, h) = self.resolution;
+        if x0 >= x1 || y0 >= y1 {
+            return Err(format!("{x0},{x1},{y0},{y1} contains no pixel"));
+        }
+        if x1 > w || y1 > h {
+            return Err(format!(
+                "{x0},{x1},{y0},{y1} reaches beyond the {w}x{h} image"
+            ));
+        }
+        if u64::from(x1 - x0) * u64::from(y1 - y0) > MAX_PIXELS {
+            return Err(format!(
+                "{x0},{x1},{y0},{y1} holds more than {MAX_PIXELS} pixels (8192x8192)"
+            ));
+        }
+        self.crop = bounds;
+        Ok(())
     }
 
     /// The defaults at a given resolution.

@@ -1,4 +1,4 @@
-//! The `acr` command line: the subcommands, one file each (`parse`, `render`, `bench`, `diff`;
+//! The `acr` command line: the subcommands, one file each (`parse`, `render`, `bench`, `diff`, `merge`;
 //! `plugins` is a one-liner here), and what they alone use (AOV files, run statistics, replays).
 
 use clap::{Parser, Subcommand};
@@ -8,6 +8,7 @@ use std::process::ExitCode;
 pub mod aov;
 pub mod bench;
 pub mod diff;
+pub mod merge;
 pub mod parse;
 pub mod render;
 pub mod replay;
@@ -45,6 +46,15 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Assemble crops of one frame (EXRs from `acr render --cropwindow` or `--pixelbounds`),
+    /// placed by their data windows, into the whole image.
+    Merge {
+        /// The merged image (.exr, .png or .pfm).
+        output: PathBuf,
+        /// The crops (.exr), which together cover the frame once.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+    },
     /// Compare an image with a reference: MSE, relMSE and PSNR (linear radiance).
     Diff {
         /// The image to judge (.exr, .pfm, .hdr or .png).
@@ -63,6 +73,7 @@ pub fn run(cli: Cli) -> ExitCode {
         Command::Parse { scene } => parse::command(&scene),
         Command::Render(args) => render::command(&args),
         Command::Bench { manifest, out } => bench::command(&manifest, out),
+        Command::Merge { output, inputs } => merge::command(&output, &inputs),
         Command::Plugins => {
             print!("{}", crate::registry::describe());
             Ok(())

@@ -5,7 +5,7 @@ use crate::cli::aov::{parse_aovs, write_aov, AovRequest};
 use crate::cli::replay::{Recording, Replay};
 use crate::cli::stats::{median, peak_rss_mb, Seconds, Stats};
 use crate::features::FeatureImage;
-use crate::image_io::{write_image, RgbImage};
+use crate::image_io::{write_image_in_frame, Frame, RgbImage};
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
 use crate::render::{render, render_with_features, Halt, Stop, MAX_SPP};
@@ -78,6 +78,43 @@ pub struct RenderArgs {
     /// No progress bar and no summary line.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Render only this window of the image, in fractions of it, X0,X1,Y0,Y1 (pbrt-v4's
+    /// --cropwindow; overrides the Film's cropwindow). An EXR output keeps the whole frame as
+    /// its display window and the crop as its data window, so crops can be merged.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_window,
+          conflicts_with = "pixelbounds")]
+    pub cropwindow: Option<[f64; 4]>,
+    /// Render only the pixels [X0, X1) x [Y0, Y1) (pbrt-v4's --pixelbounds; overrides the
+    /// Film's cropwindow).
+    #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_bounds)]
+    pub pixelbounds: Option<[u32; 4]>,
+}
+
+/// Four comma-separated numbers.
+fn four<T: std::str::FromStr>(s: &str) -> Result<[T; 4], String> {
+    let parts: Vec<T> = s
+        .split(',')
+        .map(|v| v.trim().parse::<T>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("\"{s}\" is not four comma-separated numbers X0,X1,Y0,Y1"))?;
+    <[T; 4]>::try_from(parts)
+        .map_err(|_| format!("\"{s}\" is not four comma-separated numbers X0,X1,Y0,Y1"))
+}
+
+/// A crop window: four fractions in [0, 1].
+fn parse_window(s: &str) -> Result<[f64; 4], String> {
+    let w: [f64; 4] = four(s)?;
+    if w.iter().any(|v| !(0.0..=1.0).contains(v)) {
+        return Err(format!(
+            "\"{s}\": the window's fractions must lie in [0, 1]"
+        ));
+    }
+    Ok(w)
+}
+
+/// Pixel bounds: four whole numbers.
+fn parse_bounds(s: &str) -> Result<[u32; 4], String> {
+    four(s)
 }
 
 /// The output path: the command line's, else the Film's filename (relative to the working
@@ -199,7 +236,19 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     let t_parsed = Instant::now();
 
     let mut warnings = desc.warnings.clone();
-    let scene = Scene::build(&desc, &mut warnings).map_err(|e| e.to_string())?;
+    let mut scene = Scene::build(&desc, &mut warnings).map_err(|e| e.to_string())?;
+    if let Some(w) = args.cropwindow {
+        scene
+            .film
+            .set_crop_window(w)
+            .map_err(|e| format!("--cropwindow {e}"))?;
+    }
+    if let Some(b) = args.pixelbounds {
+        scene
+            .film
+            .set_pixel_bounds(b)
+            .map_err(|e| format!("--pixelbounds {e}"))?;
+    }
     let overrides = Overrides {
         sampler: args.sampler.clone(),
         filter: args.filter.clone(),
@@ -335,7 +384,14 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     };
     let t_reconstructed = Instant::now();
     let fit_partition = plugins.filter.fit_partition();
-    write_image(&output, &image).map_err(|e| format!("{}: {e}", output.display()))?;
+    let frame = Frame {
+        width: scene.film.resolution.0 as usize,
+        height: scene.film.resolution.1 as usize,
+        x0: scene.film.crop[0] as usize,
+        y0: scene.film.crop[2] as usize,
+    };
+    write_image_in_frame(&output, &image, frame)
+        .map_err(|e| format!("{}: {e}", output.display()))?;
     for a in &aovs {
         let line = write_aov(
             a,

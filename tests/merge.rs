@@ -1,0 +1,187 @@
+//! Crops that tile a frame (`acr render --cropwindow` / `--pixelbounds`) and `acr merge`: the
+//! EXR's display and data windows, and merges equal to the whole-frame render byte for byte.
+
+use acr::image_io::read_image_with_frame;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A fresh folder for one test's files.
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("acr-merge-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn acr(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_acr"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(args: &[&str]) {
+    let o = acr(args);
+    assert!(
+        o.status.success(),
+        "acr {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// Fails cleanly (non-zero, a message, no panic) saying `says`.
+fn fails(args: &[&str], says: &str) {
+    let o = acr(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && o.status.code().is_some(),
+        "acr {args:?}: {err}"
+    );
+    assert!(
+        !err.contains("panicked") && err.contains(says),
+        "acr {args:?}: {err}"
+    );
+}
+
+fn scene() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/pbrt-v3/quadrics.pbrt")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// For every non-adaptive sampler and every splatting filter, three uneven crops of a 240x160
+/// frame, merged, equal the whole-frame render exactly: the crops sample the pixels within the
+/// filter's radius around them (pbrt-v3's sample bounds), and each pixel's sample streams are
+/// keyed by the pixel and the sample index, not by the crop.
+#[test]
+fn crops_merge_to_the_whole_frame_byte_for_byte() {
+    let dir = temp_dir("tiles");
+    let scene = scene();
+    let tiles = ["0,97,0,61", "97,240,0,61", "0,240,61,160"];
+    for sampler in ["stratified", "halton", "sobol", "random"] {
+        for filter in ["box", "gaussian", "mitchell", "triangle", "sinc"] {
+            let full = dir.join("full.exr");
+            let common = ["--spp", "2", "--sampler", sampler, "--filter", filter, "-q"];
+            let mut args = vec!["render", s(&scene), "-o", s(&full)];
+            args.extend(common);
+            ok(&args);
+            let mut parts = Vec::new();
+            for (k, b) in tiles.iter().enumerate() {
+                let part = dir.join(format!("part{k}.exr"));
+                let mut args = vec!["render", s(&scene), "-o", s(&part), "--pixelbounds", b];
+                args.extend(common);
+                ok(&args);
+                parts.push(part);
+            }
+            let (img, frame) = read_image_with_frame(&parts[1]).unwrap();
+            assert_eq!(
+                (frame.width, frame.height, frame.x0, frame.y0),
+                (240, 160, 97, 0)
+            );
+            assert_eq!((img.width, img.height), (143, 61));
+            let merged = dir.join("merged.exr");
+            let mut args = vec!["merge", s(&merged)];
+            args.extend(parts.iter().map(|p| s(p)));
+            ok(&args);
+            let (a, _) = read_image_with_frame(&merged).unwrap();
+            let (b, _) = read_image_with_frame(&full).unwrap();
+            assert!(
+                a.pixels == b.pixels,
+                "{sampler} + {filter}: the merge differs"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A crop window in fractions is pbrt-v3's: the ceiling of each edge in raster space.
+#[test]
+fn cropwindow_places_the_crop_and_bad_crops_fail_cleanly() {
+    let dir = temp_dir("window");
+    let scene = scene();
+    let out = dir.join("crop.exr");
+    let (o, sc) = (s(&out), s(&scene));
+    ok(&[
+        "render",
+        sc,
+        "-o",
+        o,
+        "--spp",
+        "1",
+        "-q",
+        "--cropwindow",
+        "0.25,0.6,0.1,0.5",
+    ]);
+    let (img, f) = read_image_with_frame(&out).unwrap();
+    assert_eq!((f.x0, f.y0, img.width, img.height), (60, 16, 84, 64));
+    fails(
+        &["render", sc, "-o", o, "--cropwindow", "0.5,0.5,0,1"],
+        "no pixel",
+    );
+    fails(
+        &["render", sc, "-o", o, "--cropwindow", "0,1.5,0,1"],
+        "[0, 1]",
+    );
+    fails(&["render", sc, "-o", o, "--cropwindow", "0,1,0"], "four");
+    fails(
+        &["render", sc, "-o", o, "--pixelbounds", "0,300,0,10"],
+        "beyond",
+    );
+    fails(
+        &[
+            "render",
+            sc,
+            "-o",
+            o,
+            "--pixelbounds",
+            "0,1,0,1",
+            "--cropwindow",
+            "0,1,0,1",
+        ],
+        "cannot be used with",
+    );
+    // Merging: overlaps, holes and crops of different frames are errors.
+    let part = |name: &str, bounds: &str| {
+        let p = dir.join(name);
+        ok(&[
+            "render",
+            sc,
+            "-o",
+            s(&p),
+            "--spp",
+            "1",
+            "-q",
+            "--pixelbounds",
+            bounds,
+        ]);
+        p
+    };
+    let a = part("a.exr", "0,120,0,160");
+    let b = part("b.exr", "100,240,0,160");
+    let c = part("c.exr", "120,240,0,100");
+    let m = dir.join("m.exr");
+    fails(&["merge", s(&m), s(&a), s(&b)], "must not overlap");
+    fails(&["merge", s(&m), s(&a), s(&c)], "in no input");
+    fails(&["merge", s(&m)], "required");
+    let other = dir.join("other.pbrt");
+    let text = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("[240]", "[200]");
+    std::fs::write(&other, text).unwrap();
+    let d = dir.join("d.exr");
+    ok(&[
+        "render",
+        s(&other),
+        "-o",
+        s(&d),
+        "--spp",
+        "1",
+        "-q",
+        "--pixelbounds",
+        "120,200,0,160",
+    ]);
+    fails(&["merge", s(&m), s(&a), s(&d)], "frame");
+    let _ = std::fs::remove_dir_all(&dir);
+}
