@@ -245,6 +245,10 @@ pub enum Bxdf {
         /// Microfacet distribution.
         distribution: TrowbridgeReitz,
     },
+    /// pbrt-v3's `HairBSDF` (the hair material), in a frame whose x is along the hair.
+    Hair(crate::hair::HairBsdf),
+    /// A lobe of pbrt-v3's Disney BSDF (`src/disney.rs`).
+    Disney(crate::disney::DisneyBxdf),
 }
 
 impl Bxdf {
@@ -273,6 +277,8 @@ impl Bxdf {
                 T::REFLECTION.or(T::GLOSSY)
             }
             Bxdf::MicrofacetTransmission { .. } => T::TRANSMISSION.or(T::GLOSSY),
+            Bxdf::Hair(_) => T::REFLECTION.or(T::TRANSMISSION).or(T::GLOSSY),
+            Bxdf::Disney(d) => d.kind(),
         }
     }
 
@@ -403,6 +409,8 @@ impl Bxdf {
                 let schlick = rs + pow5(1.0 - wi.dot(wh)) * (Spectrum::ONE - rs);
                 diffuse + distribution.d(wh) / denom * schlick
             }
+            Bxdf::Hair(h) => h.f(wo, wi),
+            Bxdf::Disney(d) => d.f(wo, wi),
         }
     }
 
@@ -573,6 +581,11 @@ impl Bxdf {
                     kind,
                 }
             }
+            Bxdf::Hair(h) => {
+                let (wi, f, pdf) = h.sample_f(wo, u);
+                LobeSample { wi, f, pdf, kind }
+            }
+            Bxdf::Disney(d) => d.sample_f(wo, u)?,
         };
         if s.pdf > 0.0 && s.pdf.is_finite() && s.f.is_finite() && s.wi.is_finite() {
             Some(s)
@@ -645,6 +658,8 @@ impl Bxdf {
                 let pdf_wh = distribution.pdf(wo, wh);
                 0.5 * (abs_cos_theta(wi) * FRAC_1_PI + pdf_wh / (4.0 * wo.dot(wh)))
             }
+            Bxdf::Hair(h) => h.pdf(wo, wi),
+            Bxdf::Disney(d) => d.pdf(wo, wi),
         };
         if p.is_finite() && p > 0.0 {
             p
@@ -788,6 +803,8 @@ impl Bsdf {
                     | Bxdf::MicrofacetTransmission { t, .. } => t,
                     Bxdf::FresnelSpecular { r, t, .. } => r.max(t),
                     Bxdf::FresnelBlend { rd, rs, .. } => rd + rs,
+                    Bxdf::Hair(h) => h.albedo(),
+                    Bxdf::Disney(d) => d.albedo(),
                 };
                 nominal * l.scale
             })
@@ -1121,6 +1138,17 @@ mod tests {
             (
                 "lambertian transmission",
                 Bxdf::LambertianTransmission { t: Spectrum::ONE },
+            ),
+            (
+                "hair",
+                Bxdf::Hair(crate::hair::HairBsdf::new(
+                    0.3,
+                    1.55,
+                    Spectrum::ZERO,
+                    0.3,
+                    0.3,
+                    2.0,
+                )),
             ),
         ]
     }

@@ -1,11 +1,11 @@
 //! pbrt-v3's materials (materials/*.cpp): matte, plastic, mirror, glass, metal, uber, substrate,
-//! translucent and mix, with textured parameters, each turning a hit into a [`Bsdf`] as pbrt-v3's
-//! `ComputeScatteringFunctions` does (radiance transport, several lobes allowed as the path
-//! integrator asks).
+//! translucent, hair ([`crate::hair`]), disney ([`crate::disney`]) and mix, with textured
+//! parameters, each turning a hit into a [`Bsdf`] as pbrt-v3's `ComputeScatteringFunctions` does
+//! (radiance transport, several lobes allowed as the path integrator asks).
 //!
 //! Bump mapping (`bumpmap` on every material) is [`crate::bump`]'s. Not supported: per-shape
 //! overrides of material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like), and the
-//! hair, subsurface, kdsubsurface, fourier and disney materials (replaced by a matte with the
+//! subsurface, kdsubsurface and fourier materials (replaced by a matte with the
 //! material's `Kd`, with a warning).
 
 use crate::bsdf::{Bsdf, Bxdf, Fresnel};
@@ -23,7 +23,7 @@ pub const COPPER_ETA: Spectrum = Spectrum::new(0.200438, 0.924033, 1.10221);
 pub const COPPER_K: Spectrum = Spectrum::new(3.91295, 2.45285, 2.14219);
 
 /// Material types acr builds.
-const KINDS: [&str; 9] = [
+const KINDS: [&str; 11] = [
     "matte",
     "translucent",
     "plastic",
@@ -32,10 +32,12 @@ const KINDS: [&str; 9] = [
     "metal",
     "uber",
     "substrate",
+    "hair",
+    "disney",
     "mix",
 ];
 /// pbrt-v3 material types acr replaces by a matte.
-const UNSUPPORTED_KINDS: [&str; 5] = ["hair", "subsurface", "kdsubsurface", "fourier", "disney"];
+const UNSUPPORTED_KINDS: [&str; 3] = ["subsurface", "kdsubsurface", "fourier"];
 /// Types that make no surface: rays pass through.
 const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
 /// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
@@ -152,6 +154,12 @@ pub enum Material {
         /// Whether roughness goes through `roughness_to_alpha`.
         remap_roughness: bool,
     },
+    /// pbrt-v3's hair (Chiang et al.'s fibre scattering, [`crate::hair`]), for curves: its
+    /// absorption from `sigma_a`, `color` or melanin concentrations, `eta`, `beta_m`, `beta_n`,
+    /// `alpha`.
+    Hair(crate::hair::HairMaterial),
+    /// pbrt-v3's `disney` ([`crate::disney`]).
+    Disney(Box<crate::disney::DisneyMaterial>),
     /// pbrt-v3's mix: the lobes of `materials[0]` weighted by `amount`, those of `materials[1]`
     /// by 1 - amount.
     Mix {
@@ -549,6 +557,16 @@ impl Material {
                     }
                 }
             }
+            Material::Hair(hair) => {
+                let (bxdf, eta) = hair.bxdf(si);
+                if first {
+                    b.set_eta(eta);
+                }
+                b.add_scaled(Bxdf::Hair(bxdf), scale);
+            }
+            // pbrt-v3's Disney BSDF keeps the relative index 1 (its transmission is rough, and
+            // only a specular one scales Russian roulette by it).
+            Material::Disney(d) => d.add_lobes(si, b, scale),
             Material::Mix { amount, materials } => {
                 let s1 = clamp0(amount.eval(si));
                 let s2 = clamp0(Spectrum::ONE - s1);
@@ -587,7 +605,8 @@ impl<'a> MaterialBuilder<'a> {
         self.in_progress[index] = true;
         let mut m = Arc::new(self.make(md)?);
         let p = &md.plugin.params;
-        if !m.is_interface() {
+        // pbrt-v3's hair reads no bumpmap (left unused, so reported as such).
+        if !m.is_interface() && !matches!(*m, Material::Hair(_)) {
             if let Some(map) = self.textures.float_param_opt(p, "bumpmap")? {
                 m = Arc::new(Material::Bumped {
                     map: Arc::new(map),
@@ -684,6 +703,10 @@ impl<'a> MaterialBuilder<'a> {
                 roughness: t.float_param(p, "roughness", 0.1)?,
                 remap_roughness: remap(p)?,
             },
+            "hair" => Material::Hair(crate::hair::HairMaterial::from_params(t, p, loc)?),
+            "disney" => Material::Disney(Box::new(crate::disney::DisneyMaterial::from_params(
+                t, p, loc,
+            )?)),
             "mix" => {
                 let amount = t.spectrum_param(p, "amount", Spectrum::splat(0.5))?;
                 let Some([a, b]) = md.mix else {
@@ -1092,7 +1115,7 @@ mod tests {
         assert!(matches!(e, Error::At { .. }));
 
         let (m, w) = build(&format!(
-            "Material \"hair\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
+            "Material \"fourier\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
         ));
         assert_eq!(w.len(), 1);
         assert!(matches!(m.last().unwrap(), Material::Matte { .. }));

@@ -343,6 +343,8 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("curves.pbrt", "curves", 16),
     ("nurbs.pbrt", "nurbs", 16),
     ("image-lights.pbrt", "image-lights", 16),
+    ("disney.pbrt", "disney", 16),
+    ("hair.pbrt", "hair", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

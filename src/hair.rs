@@ -1,0 +1,1016 @@
+//! pbrt-v3's hair material (materials/hair.{h,cpp}): Chiang et al.'s hair scattering model as
+//! pbrt-v3 implements it ("The Implementation of a Hair Scattering Model", pbrt.org/hair.pdf),
+//! [`HairBsdf`], and the material that builds it at a hit, [`HairMaterial`].
+//!
+//! The lobe works in the BSDF's local frame as pbrt-v3's does: x along the hair (the curve's
+//! dp/du, which [`crate::bsdf::Bsdf`] takes as its first axis), z the shading normal, so that
+//! `w.x` is sin theta (the angle to the plane normal to the hair) and atan2(w.z, w.y) is phi
+//! about the hair. The offset across the hair is h = -1 + 2 v, from the curve's v.
+//!
+//! The arithmetic follows pbrt-v3's single-precision code step by step (its double-precision
+//! literals included) so that values match its own to a few ulps; where pbrt-v3 `CHECK`s and
+//! aborts (h outside [-1, 1], beta outside [0, 1]), the inputs are clamped, and a NaN from a
+//! degenerate direction is left for the BSDF to turn into zero.
+
+use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
+use crate::texture::{FloatTexture, SpectrumTexture, Texture, TextureBuilder};
+use acr_parser::{Error, Loc, ParamList, Result};
+use std::f32::consts::PI;
+
+/// pbrt-v3's `pMax`: the scattering orders modelled one by one (R, TT, TRT); the rest are
+/// summed into one more term.
+const P_MAX: usize = 3;
+/// sqrt(pi / 8), pbrt-v3's `SqrtPiOver8`, its literal as written.
+#[allow(clippy::excessive_precision)]
+const SQRT_PI_OVER_8: f32 = 0.626657069;
+
+#[inline]
+fn sqr(v: f32) -> f32 {
+    v * v
+}
+
+/// pbrt-v3's `Pow<n>`, with its order of multiplications (so that results round alike).
+fn pow_n(v: f32, n: u32) -> f32 {
+    match n {
+        0 => 1.0,
+        1 => v,
+        _ => {
+            let n2 = pow_n(v, n / 2);
+            n2 * n2 * pow_n(v, n & 1)
+        }
+    }
+}
+
+/// asin with its argument clamped to [-1, 1] (pbrt-v3's `SafeASin`, without its check).
+#[inline]
+fn safe_asin(x: f32) -> f32 {
+    x.clamp(-1.0, 1.0).asin()
+}
+
+/// sqrt of max(0, x) (pbrt-v3's `SafeSqrt`, without its check; NaN gives 0, as there).
+#[inline]
+fn safe_sqrt(x: f32) -> f32 {
+    x.max(0.0).sqrt()
+}
+
+/// The modified Bessel function I0 by its first ten series terms (pbrt-v3's `I0`).
+fn i0(x: f32) -> f32 {
+    let mut val = 0.0f32;
+    let mut x2i = 1.0f32;
+    let mut ifact: i64 = 1;
+    let mut i4: i32 = 1;
+    for i in 0..10i64 {
+        if i > 1 {
+            ifact *= i;
+        }
+        val += x2i / (i4 as f32 * sqr(ifact as f32));
+        x2i *= x * x;
+        i4 *= 4;
+    }
+    val
+}
+
+/// log I0(x), asymptotic past 12 (pbrt-v3's `LogI0`; its `0.5` is a double, so the last steps
+/// are in double precision there and here).
+fn log_i0(x: f32) -> f32 {
+    if x > 12.0 {
+        let inner = -(2.0 * PI).ln() + (1.0 / x).ln() + 1.0 / (8.0 * x);
+        (x as f64 + 0.5 * inner as f64) as f32
+    } else {
+        i0(x).ln()
+    }
+}
+
+/// The longitudinal scattering function M_p (pbrt-v3's `Mp`), in log space for small variance.
+// pbrt-v3 writes ln 2 as 0.6931f: kept, so that values round alike.
+#[allow(clippy::approx_constant)]
+fn mp(cos_theta_i: f32, cos_theta_o: f32, sin_theta_i: f32, sin_theta_o: f32, v: f32) -> f32 {
+    let a = cos_theta_i * cos_theta_o / v;
+    let b = sin_theta_i * sin_theta_o / v;
+    // pbrt-v3 compares with the double 0.1, which 0.1f32 exceeds.
+    if v as f64 <= 0.1 {
+        (log_i0(a) - b - 1.0 / v + 0.6931 + (1.0 / (2.0 * v)).ln()).exp()
+    } else {
+        ((-b).exp() * i0(a)) / ((1.0 / v).sinh() * 2.0 * v)
+    }
+}
+
+/// The attenuations A_p for p = 0..=3 (pbrt-v3's `Ap`): Fresnel reflection at the cylinder and
+/// the transmittance `t` of one pass through it; the last sums every higher order.
+fn ap(cos_theta_o: f32, eta: f32, h: f32, t: Spectrum) -> [Spectrum; P_MAX + 1] {
+    let cos_gamma_o = safe_sqrt(1.0 - h * h);
+    let cos_theta = cos_theta_o * cos_gamma_o;
+    let f = crate::bsdf::fr_dielectric(cos_theta, 1.0, eta);
+    let mut a = [Spectrum::ZERO; P_MAX + 1];
+    a[0] = Spectrum::splat(f);
+    a[1] = sqr(1.0 - f) * t;
+    for p in 2..P_MAX {
+        a[p] = a[p - 1] * t * f;
+    }
+    a[P_MAX] = a[P_MAX - 1] * f * t / (Spectrum::ONE - t * f);
+    a
+}
+
+/// The azimuthal angle out of the hair after p internal passes (pbrt-v3's `Phi`).
+#[inline]
+fn phi(p: usize, gamma_o: f32, gamma_t: f32) -> f32 {
+    (2 * p) as f32 * gamma_t - 2.0 * gamma_o + p as f32 * PI
+}
+
+/// The logistic distribution's density, scale `s` (pbrt-v3's `Logistic`).
+#[inline]
+fn logistic(x: f32, s: f32) -> f32 {
+    let x = x.abs();
+    (-x / s).exp() / (s * sqr(1.0 + (-x / s).exp()))
+}
+
+/// The logistic distribution's CDF (pbrt-v3's `LogisticCDF`).
+#[inline]
+fn logistic_cdf(x: f32, s: f32) -> f32 {
+    1.0 / (1.0 + (-x / s).exp())
+}
+
+/// The logistic density renormalised over [a, b] (pbrt-v3's `TrimmedLogistic`).
+#[inline]
+fn trimmed_logistic(x: f32, s: f32, a: f32, b: f32) -> f32 {
+    logistic(x, s) / (logistic_cdf(b, s) - logistic_cdf(a, s))
+}
+
+/// The azimuthal scattering function N_p (pbrt-v3's `Np`): a trimmed logistic about
+/// [`phi`], the difference taken into [-pi, pi].
+fn np(phi_: f32, p: usize, s: f32, gamma_o: f32, gamma_t: f32) -> f32 {
+    let mut dphi = phi_ - phi(p, gamma_o, gamma_t);
+    while dphi > PI {
+        dphi -= 2.0 * PI;
+    }
+    while dphi < -PI {
+        dphi += 2.0 * PI;
+    }
+    trimmed_logistic(dphi, s, -PI, PI)
+}
+
+/// Samples the trimmed logistic by inverting its CDF (pbrt-v3's `SampleTrimmedLogistic`).
+fn sample_trimmed_logistic(u: f32, s: f32, a: f32, b: f32) -> f32 {
+    let k = logistic_cdf(b, s) - logistic_cdf(a, s);
+    let x = -s * (1.0 / (u * k + logistic_cdf(a, s)) - 1.0).ln();
+    x.clamp(a, b)
+}
+
+/// Keeps the even bits of `x`, packed into its low 16 (pbrt-v3's `Compact1By1`).
+fn compact1by1(mut x: u32) -> u32 {
+    x &= 0x5555_5555;
+    x = (x ^ (x >> 1)) & 0x3333_3333;
+    x = (x ^ (x >> 2)) & 0x0f0f_0f0f;
+    x = (x ^ (x >> 4)) & 0x00ff_00ff;
+    x = (x ^ (x >> 8)) & 0x0000_ffff;
+    x
+}
+
+/// Two 16-bit samples from one in [0, 1): its 32 fraction bits, even and odd ones
+/// de-interleaved (pbrt-v3's `DemuxFloat`, which lets `Sample_f` take four numbers from two).
+pub fn demux_float(f: f32) -> Vec2 {
+    // pbrt-v3 checks 0 <= f < 1; out-of-range samples are clamped instead.
+    let f = f.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+    let v = (f * 4_294_967_296.0) as u64;
+    let bits = [compact1by1(v as u32), compact1by1((v >> 1) as u32)];
+    Vec2::new(
+        bits[0] as f32 / (1u32 << 16) as f32,
+        bits[1] as f32 / (1u32 << 16) as f32,
+    )
+}
+
+/// pbrt-v3's `SigmaAFromConcentration`: absorption from eumelanin and pheomelanin
+/// concentrations (RGB, as pbrt-v3's default `RGBSpectrum` build).
+pub fn sigma_a_from_concentration(ce: f32, cp: f32) -> Spectrum {
+    const EUMELANIN: [f32; 3] = [0.419, 0.697, 1.37];
+    const PHEOMELANIN: [f32; 3] = [0.187, 0.4, 1.05];
+    Spectrum::from_array(std::array::from_fn(|i| {
+        ce * EUMELANIN[i] + cp * PHEOMELANIN[i]
+    }))
+}
+
+/// The polynomial in beta_n that relates sqrt(sigma_a) to -ln(colour) (Chiang et al.'s fit).
+fn reflectance_poly(beta_n: f32) -> f32 {
+    5.969 - 0.215 * beta_n + 2.532 * sqr(beta_n) - 10.73 * pow_n(beta_n, 3)
+        + 5.574 * pow_n(beta_n, 4)
+        + 0.245 * pow_n(beta_n, 5)
+}
+
+/// pbrt-v3's `SigmaAFromReflectance`: the absorption that gives a hair of azimuthal roughness
+/// `beta_n` about the colour `c` after multiple scattering.
+pub fn sigma_a_from_reflectance(c: Spectrum, beta_n: f32) -> Spectrum {
+    let d = reflectance_poly(beta_n);
+    Spectrum::from_array(c.to_array().map(|ci| sqr(ci.ln() / d)))
+}
+
+/// pbrt-v3's `HairBSDF` at one point across a hair: reflection and transmission in every
+/// direction (glossy), its values precomputed as pbrt-v3's constructor does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HairBsdf {
+    /// Offset across the hair, in [-1, 1].
+    h: f32,
+    /// asin(h).
+    gamma_o: f32,
+    /// Index of refraction of the hair's interior.
+    eta: f32,
+    /// Absorption coefficient of the interior (per unit radius).
+    sigma_a: Spectrum,
+    /// Azimuthal roughness (kept for [`HairBsdf::albedo`]).
+    beta_n: f32,
+    /// Longitudinal variance v_0; pbrt-v3's v_1 and v_2 (= v_3) are v_0 / 4 and 4 v_0.
+    v0: f32,
+    /// Logistic scale of the azimuthal lobes.
+    s: f32,
+    /// sin(2^k alpha), k = 0, 1, 2: the scales' tilt.
+    sin_2k_alpha: [f32; 3],
+    /// cos(2^k alpha).
+    cos_2k_alpha: [f32; 3],
+}
+
+impl HairBsdf {
+    /// pbrt-v3's `HairBSDF(h, eta, sigma_a, beta_m, beta_n, alpha)`, `alpha` in degrees. `h` is
+    /// clamped to [-1, 1] and the betas to [0, 1] (pbrt-v3 aborts outside them).
+    pub fn new(h: f32, eta: f32, sigma_a: Spectrum, beta_m: f32, beta_n: f32, alpha: f32) -> Self {
+        let h = h.clamp(-1.0, 1.0);
+        let beta_m = beta_m.clamp(0.0, 1.0);
+        let beta_n = beta_n.clamp(0.0, 1.0);
+        let v0 = sqr(0.726 * beta_m + 0.812 * sqr(beta_m) + 3.7 * pow_n(beta_m, 20));
+        let s = SQRT_PI_OVER_8 * (0.265 * beta_n + 1.194 * sqr(beta_n) + 5.372 * pow_n(beta_n, 22));
+        let mut sin_2k_alpha = [0.0; 3];
+        let mut cos_2k_alpha = [0.0; 3];
+        sin_2k_alpha[0] = ((PI / 180.0) * alpha).sin();
+        cos_2k_alpha[0] = safe_sqrt(1.0 - sqr(sin_2k_alpha[0]));
+        for i in 1..3 {
+            sin_2k_alpha[i] = 2.0 * cos_2k_alpha[i - 1] * sin_2k_alpha[i - 1];
+            cos_2k_alpha[i] = sqr(cos_2k_alpha[i - 1]) - sqr(sin_2k_alpha[i - 1]);
+        }
+        Self {
+            h,
+            gamma_o: safe_asin(h),
+            eta,
+            sigma_a,
+            beta_n,
+            v0,
+            s,
+            sin_2k_alpha,
+            cos_2k_alpha,
+        }
+    }
+
+    /// Longitudinal variance of order p (pbrt-v3's `v[p]`: exact scalings of v_0).
+    #[inline]
+    fn v(&self, p: usize) -> f32 {
+        match p {
+            0 => self.v0,
+            1 => 0.25 * self.v0,
+            _ => 4.0 * self.v0,
+        }
+    }
+
+    /// sin and cos of theta_o rotated by the scales' tilt for order p: -2 alpha for R,
+    /// alpha for TT, 4 alpha for TRT, none beyond.
+    #[inline]
+    fn tilt(&self, p: usize, sin_o: f32, cos_o: f32) -> (f32, f32) {
+        let (s, c) = (&self.sin_2k_alpha, &self.cos_2k_alpha);
+        match p {
+            0 => (sin_o * c[1] - cos_o * s[1], cos_o * c[1] + sin_o * s[1]),
+            1 => (sin_o * c[0] + cos_o * s[0], cos_o * c[0] - sin_o * s[0]),
+            2 => (sin_o * c[2] + cos_o * s[2], cos_o * c[2] - sin_o * s[2]),
+            _ => (sin_o, cos_o),
+        }
+    }
+
+    /// gamma_t, the refracted ray's offset angle, for sin theta_o and cos theta_o.
+    #[inline]
+    fn gamma_t(&self, sin_o: f32, cos_o: f32) -> f32 {
+        let etap = (self.eta * self.eta - sqr(sin_o)).sqrt() / cos_o;
+        safe_asin(self.h / etap)
+    }
+
+    /// The transmittance of one pass through the cylinder (pbrt-v3's `T`).
+    #[inline]
+    fn transmittance(&self, sin_o: f32, cos_o: f32) -> Spectrum {
+        let sin_theta_t = sin_o / self.eta;
+        let cos_theta_t = safe_sqrt(1.0 - sqr(sin_theta_t));
+        let etap = (self.eta * self.eta - sqr(sin_o)).sqrt() / cos_o;
+        let sin_gamma_t = self.h / etap;
+        let cos_gamma_t = safe_sqrt(1.0 - sqr(sin_gamma_t));
+        let d = 2.0 * cos_gamma_t / cos_theta_t;
+        Spectrum::from_array((-self.sigma_a * d).to_array().map(f32::exp))
+    }
+
+    /// The lobe's value for local `wo` and `wi` (pbrt-v3's `HairBSDF::f`): the sum over
+    /// orders of M_p A_p N_p, divided by |cos theta| to the normal as pbrt-v3 does (the
+    /// integrator's cosine cancels it: a fibre is not a surface).
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+        let sin_o = wo.x;
+        let cos_o = safe_sqrt(1.0 - sqr(sin_o));
+        let phi_o = wo.z.atan2(wo.y);
+        let sin_i = wi.x;
+        let cos_i = safe_sqrt(1.0 - sqr(sin_i));
+        let phi_i = wi.z.atan2(wi.y);
+        let t = self.transmittance(sin_o, cos_o);
+        let gamma_t = self.gamma_t(sin_o, cos_o);
+        let dphi = phi_i - phi_o;
+        let a = ap(cos_o, self.eta, self.h, t);
+        let mut fsum = Spectrum::ZERO;
+        for (p, ap) in a.iter().enumerate().take(P_MAX) {
+            let (sin_op, cos_op) = self.tilt(p, sin_o, cos_o);
+            // The tilt can take theta_o past the pole.
+            let cos_op = cos_op.abs();
+            fsum += *ap
+                * mp(cos_i, cos_op, sin_i, sin_op, self.v(p))
+                * np(dphi, p, self.s, self.gamma_o, gamma_t);
+        }
+        fsum += a[P_MAX] * mp(cos_i, cos_o, sin_i, sin_o, self.v(P_MAX)) / (2.0 * PI);
+        let abs_cos = wi.z.abs();
+        if abs_cos > 0.0 {
+            fsum /= abs_cos;
+        }
+        fsum
+    }
+
+    /// The probability of choosing each order in [`HairBsdf::sample_f`]: A_p's luminances,
+    /// normalised (pbrt-v3's `ComputeApPdf`).
+    fn ap_pdf(&self, cos_o: f32) -> [f32; P_MAX + 1] {
+        let sin_o = safe_sqrt(1.0 - cos_o * cos_o);
+        let t = self.transmittance(sin_o, cos_o);
+        let a = ap(cos_o, self.eta, self.h, t);
+        let y = a.map(crate::spectrum_luminance);
+        let sum_y = y.iter().fold(0.0f32, |s, &v| s + v);
+        y.map(|v| v / sum_y)
+    }
+
+    /// The density of `wi` given the orders' probabilities, with `dphi` the azimuth
+    /// difference (unwrapped or not).
+    #[allow(clippy::too_many_arguments)]
+    fn pdf_terms(
+        &self,
+        ap_pdf: &[f32; P_MAX + 1],
+        sin_o: f32,
+        cos_o: f32,
+        sin_i: f32,
+        cos_i: f32,
+        dphi: f32,
+        gamma_t: f32,
+    ) -> f32 {
+        let mut pdf = 0.0f32;
+        for (p, &w) in ap_pdf.iter().enumerate().take(P_MAX) {
+            let (sin_op, cos_op) = self.tilt(p, sin_o, cos_o);
+            let cos_op = cos_op.abs();
+            pdf += mp(cos_i, cos_op, sin_i, sin_op, self.v(p))
+                * w
+                * np(dphi, p, self.s, self.gamma_o, gamma_t);
+        }
+        pdf += mp(cos_i, cos_o, sin_i, sin_o, self.v(P_MAX)) * ap_pdf[P_MAX] * (1.0 / (2.0 * PI));
+        pdf
+    }
+
+    /// Samples `wi` for local `wo` (pbrt-v3's `HairBSDF::Sample_f`): each of `u`'s two numbers
+    /// is split into two ([`demux_float`]); one chooses the order p by [`HairBsdf::ap_pdf`], one
+    /// samples N_p and two M_p. Returns (wi, f, pdf).
+    pub fn sample_f(&self, wo: Vec3, u2: Vec2) -> (Vec3, Spectrum, f32) {
+        let sin_o = wo.x;
+        let cos_o = safe_sqrt(1.0 - sqr(sin_o));
+        let phi_o = wo.z.atan2(wo.y);
+        let mut u = [demux_float(u2.x), demux_float(u2.y)];
+        let ap_pdf = self.ap_pdf(cos_o);
+        let mut p = 0;
+        while p < P_MAX {
+            if u[0].x < ap_pdf[p] {
+                break;
+            }
+            u[0].x -= ap_pdf[p];
+            p += 1;
+        }
+        let (sin_op, cos_op) = self.tilt(p, sin_o, cos_o);
+        // Sample M_p for theta_i.
+        u[1].x = u[1].x.max(1e-5);
+        let vp = self.v(p);
+        let cos_theta = 1.0 + vp * (u[1].x + (1.0 - u[1].x) * (-2.0 / vp).exp()).ln();
+        let sin_theta = safe_sqrt(1.0 - sqr(cos_theta));
+        let cos_phi = (2.0 * PI * u[1].y).cos();
+        let sin_i = -cos_theta * sin_op + sin_theta * cos_phi * cos_op;
+        let cos_i = safe_sqrt(1.0 - sqr(sin_i));
+        // Sample N_p for the azimuth.
+        let gamma_t = self.gamma_t(sin_o, cos_o);
+        let dphi = if p < P_MAX {
+            phi(p, self.gamma_o, gamma_t) + sample_trimmed_logistic(u[0].y, self.s, -PI, PI)
+        } else {
+            2.0 * PI * u[0].y
+        };
+        let phi_i = phi_o + dphi;
+        let wi = Vec3::new(sin_i, cos_i * phi_i.cos(), cos_i * phi_i.sin());
+        let pdf = self.pdf_terms(&ap_pdf, sin_o, cos_o, sin_i, cos_i, dphi, gamma_t);
+        (wi, self.f(wo, wi), pdf)
+    }
+
+    /// The density with which [`HairBsdf::sample_f`] picks `wi` (pbrt-v3's `HairBSDF::Pdf`).
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let sin_o = wo.x;
+        let cos_o = safe_sqrt(1.0 - sqr(sin_o));
+        let phi_o = wo.z.atan2(wo.y);
+        let sin_i = wi.x;
+        let cos_i = safe_sqrt(1.0 - sqr(sin_i));
+        let phi_i = wi.z.atan2(wi.y);
+        let gamma_t = self.gamma_t(sin_o, cos_o);
+        let ap_pdf = self.ap_pdf(cos_o);
+        self.pdf_terms(&ap_pdf, sin_o, cos_o, sin_i, cos_i, phi_i - phi_o, gamma_t)
+    }
+
+    /// A nominal colour for first-hit features: the reflectance that pbrt-v3's
+    /// [`sigma_a_from_reflectance`] maps to this absorption (its inverse).
+    pub fn albedo(&self) -> Spectrum {
+        let d = reflectance_poly(self.beta_n);
+        Spectrum::from_array(
+            self.sigma_a
+                .to_array()
+                .map(|s| (-s.max(0.0).sqrt() * d).exp()),
+        )
+    }
+}
+
+/// pbrt-v3's `HairMaterial`: the parameters, textured, from which a hit gets its [`HairBsdf`].
+/// Its absorption comes from `sigma_a` if given, else from `color`, else from the melanin
+/// concentrations (pbrt-v3's precedence; with none of them, eumelanin 1.3 as `sigma_a`).
+#[derive(Clone, Debug)]
+pub struct HairMaterial {
+    /// Absorption coefficient of the interior, per unit radius.
+    pub sigma_a: Option<SpectrumTexture>,
+    /// The colour the hair should look, turned into an absorption.
+    pub color: Option<SpectrumTexture>,
+    /// Eumelanin concentration (brown-black).
+    pub eumelanin: Option<FloatTexture>,
+    /// Pheomelanin concentration (red-yellow).
+    pub pheomelanin: Option<FloatTexture>,
+    /// Index of refraction of the interior (1.55).
+    pub eta: FloatTexture,
+    /// Longitudinal roughness in (0, 1] (0.3).
+    pub beta_m: FloatTexture,
+    /// Azimuthal roughness in (0, 1] (0.3).
+    pub beta_n: FloatTexture,
+    /// The scales' tilt in degrees (2).
+    pub alpha: FloatTexture,
+}
+
+impl HairMaterial {
+    /// pbrt-v3's `CreateHairMaterial`: its precedence among `sigma_a`, `color` and the melanins,
+    /// with its warnings for the ones ignored (at their location). A constant `beta_m` or
+    /// `beta_n` outside (0, 1] or `eta` below 1 is a located error: pbrt-v3 aborts on them.
+    pub fn from_params(t: &mut TextureBuilder<'_>, p: &ParamList, loc: &Loc) -> Result<Self> {
+        let mut sigma_a = t.spectrum_param_opt(p, "sigma_a")?;
+        let color = t.spectrum_param_opt(p, "color")?;
+        let eumelanin = t.float_param_opt(p, "eumelanin")?;
+        let pheomelanin = t.float_param_opt(p, "pheomelanin")?;
+        let used = if sigma_a.is_some() {
+            Some("\"sigma_a\"")
+        } else if color.is_some() {
+            Some("\"color\"")
+        } else if eumelanin.is_some() || pheomelanin.is_some() {
+            Some("\"eumelanin\"/\"pheomelanin\"")
+        } else {
+            None
+        };
+        if let Some(used) = used {
+            let given = [
+                ("sigma_a", sigma_a.is_some()),
+                ("color", color.is_some()),
+                ("eumelanin", eumelanin.is_some()),
+                ("pheomelanin", pheomelanin.is_some()),
+            ];
+            for (name, present) in given {
+                if present && !used.contains(&format!("\"{name}\"")) {
+                    let at = p.get(name).map_or_else(|| loc.clone(), |q| q.loc.clone());
+                    t.warn_once(
+                        format!("hair ignores {name} at {at}"),
+                        &at,
+                        format!("Ignoring \"{name}\" parameter since {used} was provided."),
+                    );
+                }
+            }
+        } else {
+            // pbrt-v3's default: brown-ish hair.
+            sigma_a = Some(Texture::Constant(sigma_a_from_concentration(1.3, 0.0)));
+        }
+        let mut float = |name: &str, default: f32, ok: fn(f32) -> bool, range: &str| {
+            let tex = t.float_param(p, name, default)?;
+            match tex.as_constant() {
+                Some(v) if !ok(v) => {
+                    let at = p.get(name).map_or_else(|| loc.clone(), |q| q.loc.clone());
+                    Err(Error::at(
+                        &at,
+                        format!("hair \"{name}\" {v} is not {range} (pbrt-v3 aborts on it)"),
+                    ))
+                }
+                _ => Ok(tex),
+            }
+        };
+        let beta_ok: fn(f32) -> bool = |v| v > 0.0 && v <= 1.0;
+        Ok(Self {
+            sigma_a,
+            color,
+            eumelanin,
+            pheomelanin,
+            eta: float("eta", 1.55, |v| v >= 1.0, "at least 1")?,
+            beta_m: float("beta_m", 0.3, beta_ok, "in (0, 1]")?,
+            beta_n: float("beta_n", 0.3, beta_ok, "in (0, 1]")?,
+            alpha: float("alpha", 2.0, f32::is_finite, "finite")?,
+        })
+    }
+
+    /// The lobe at a hit and the BSDF's relative index (pbrt-v3's
+    /// `HairMaterial::ComputeScatteringFunctions`): h = -1 + 2 v across the curve.
+    pub fn bxdf(&self, si: &SurfaceInteraction) -> (HairBsdf, f32) {
+        let bm = self.beta_m.eval(si);
+        let bn = self.beta_n.eval(si);
+        let a = self.alpha.eval(si);
+        let e = self.eta.eval(si);
+        let sig_a = if let Some(s) = &self.sigma_a {
+            s.eval(si).max(Spectrum::ZERO)
+        } else if let Some(c) = &self.color {
+            sigma_a_from_reflectance(c.eval(si).max(Spectrum::ZERO), bn)
+        } else {
+            let c = |t: &Option<FloatTexture>| t.as_ref().map_or(0.0, |t| t.eval(si)).max(0.0);
+            sigma_a_from_concentration(c(&self.eumelanin), c(&self.pheomelanin))
+        };
+        let h = -1.0 + 2.0 * si.uv.y;
+        (HairBsdf::new(h, e, sig_a, bm, bn, a), e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::check::Rng;
+    use crate::bsdf::{Bsdf, Bxdf};
+    use crate::material::{build_materials, Material};
+    use crate::sampling::uniform_sample_sphere;
+    use acr_parser::{parse_str, Warning};
+    use std::path::Path;
+
+    /// 1 / (4 pi), pbrt-v3's `UniformSpherePdf`.
+    const UNIFORM_SPHERE_PDF: f32 = std::f32::consts::FRAC_1_PI / 4.0;
+
+    /// `f`, `Pdf`, `Sample_f`, `DemuxFloat` and the two absorption conversions against the
+    /// values pbrt-v3's own code printed for 30 hairs (h from -1 to 1, beta_m from 0.05 to 1,
+    /// both branches of M_p, tilts of -3 to 5 degrees, absorption none, from melanins and from
+    /// colours), 300 pairs of directions and 300 samples (tests/data/pbrt-v3/haircheck.cpp).
+    /// Built without fused multiply-adds, pbrt-v3 gives the same floats as acr on this machine;
+    /// the margin is for other platforms' libm. (pbrt-v3's own -march=native build fuses them:
+    /// up to 2.4e-4 apart in the sharpest lobes.)
+    #[test]
+    fn values_match_pbrt_v3() {
+        let data = include_str!("../tests/data/pbrt-v3/hair-values.txt");
+        let mut hair = None;
+        let mut counts = [0usize; 6];
+        // Largest relative differences seen: f, pdf, sampled direction (absolute).
+        let mut worst = [0.0f32; 3];
+        let rel = |a: f32, b: f32| (a - b).abs() / (a.abs().max(b.abs()) + 1e-30);
+        for line in data.lines() {
+            let w: Vec<&str> = line.split_whitespace().filter(|s| *s != "->").collect();
+            let n: Vec<f32> = w[1..].iter().map(|s| s.parse().unwrap()).collect();
+            let v3 = |i: usize| Vec3::new(n[i], n[i + 1], n[i + 2]);
+            let spectrum = |got: Spectrum, want: Spectrum, worst: &mut f32| {
+                for c in 0..3 {
+                    *worst = worst.max(rel(got[c], want[c]));
+                }
+            };
+            match w[0] {
+                "demux" => {
+                    counts[0] += 1;
+                    assert_eq!(demux_float(n[0]), Vec2::new(n[1], n[2]), "{line}");
+                }
+                "conc" => {
+                    counts[1] += 1;
+                    let mut e = 0.0;
+                    spectrum(sigma_a_from_concentration(n[0], n[1]), v3(2), &mut e);
+                    assert!(e < 1e-6, "{e}: {line}");
+                }
+                "refl" => {
+                    counts[2] += 1;
+                    let mut e = 0.0;
+                    spectrum(sigma_a_from_reflectance(v3(0), n[3]), v3(4), &mut e);
+                    assert!(e < 1e-5, "{e}: {line}");
+                }
+                "hair" => {
+                    counts[3] += 1;
+                    hair = Some(HairBsdf::new(n[0], n[1], v3(2), n[5], n[6], n[7]));
+                }
+                "f" => {
+                    counts[4] += 1;
+                    let h = hair.unwrap();
+                    spectrum(h.f(v3(0), v3(3)), v3(6), &mut worst[0]);
+                    worst[1] = worst[1].max(rel(h.pdf(v3(0), v3(3)), n[9]));
+                }
+                "s" => {
+                    counts[5] += 1;
+                    let h = hair.unwrap();
+                    let (wi, f, pdf) = h.sample_f(v3(0), Vec2::new(n[3], n[4]));
+                    worst[2] = worst[2].max((wi - v3(5)).length());
+                    spectrum(f, v3(9), &mut worst[0]);
+                    worst[1] = worst[1].max(rel(pdf, n[8]));
+                }
+                _ => panic!("{line}"),
+            }
+        }
+        assert_eq!(counts, [20, 10, 10, 30, 300, 300]);
+        assert!(
+            worst[0] < 1e-5 && worst[1] < 1e-5 && worst[2] < 1e-6,
+            "{worst:?}"
+        );
+    }
+
+    /// pbrt-v3's `RNG` (PCG32 with its default state and stream) and `UniformFloat`, so that
+    /// the tests ported from pbrt-v3 draw its own numbers: their Monte Carlo estimates are
+    /// then pbrt-v3's, and its bounds hold as they did there.
+    struct PbrtRng {
+        state: u64,
+        inc: u64,
+    }
+
+    impl PbrtRng {
+        fn new() -> Self {
+            Self {
+                state: 0x853c_49e6_748f_ea9b,
+                inc: 0xda3e_39cb_94b9_5bdb,
+            }
+        }
+
+        fn uniform_u32(&mut self) -> u32 {
+            let old = self.state;
+            self.state = old
+                .wrapping_mul(0x5851_f42d_4c95_7f2d)
+                .wrapping_add(self.inc);
+            let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+            xorshifted.rotate_right((old >> 59) as u32)
+        }
+
+        fn uniform_float(&mut self) -> f32 {
+            (self.uniform_u32() as f32 / 4_294_967_296.0).min(1.0 - f32::EPSILON / 2.0)
+        }
+
+        /// Two numbers in order, as pbrt-v3's `{rng.UniformFloat(), rng.UniformFloat()}`.
+        fn uniform_2d(&mut self) -> Vec2 {
+            let a = self.uniform_float();
+            Vec2::new(a, self.uniform_float())
+        }
+    }
+
+    /// pbrt-v3's `Hair.Pow` test: its `Pow<n>` for n up to 29.
+    #[test]
+    fn pow_gives_powers_of_two() {
+        for n in 0..30 {
+            assert_eq!(pow_n(2.0, n), (1u32 << n) as f32);
+        }
+    }
+
+    /// Calls `body(beta_m, beta_n)` over pbrt-v3's float loops
+    /// `for (beta = start; beta < 1; beta += .2)`, in f32 as there.
+    fn beta_loops(start_m: f32, start_n: f32, mut body: impl FnMut(f32, f32)) {
+        let mut beta_m = start_m;
+        while beta_m < 1.0 {
+            let mut beta_n = start_n;
+            while beta_n < 1.0 {
+                body(beta_m, beta_n);
+                beta_n += 0.2;
+            }
+            beta_m += 0.2;
+        }
+    }
+
+    /// pbrt-v3's `Hair.WhiteFurnace`: without absorption, the hair scatters all the light of a
+    /// uniform environment (within 5%), estimated with uniform directions.
+    #[test]
+    fn white_furnace() {
+        let mut rng = PbrtRng::new();
+        let wo = uniform_sample_sphere(rng.uniform_2d());
+        // pbrt-v3's own first direction (printed by it): the same numbers are drawn.
+        assert!(
+            (wo - Vec3::new(0.54987, 0.0335902, 0.834575)).length() < 1e-5,
+            "{wo}"
+        );
+        beta_loops(0.1, 0.1, |beta_m, beta_n| {
+            let count = 300_000;
+            let mut sum = Spectrum::ZERO;
+            for _ in 0..count {
+                let h = (-1.0 + 2.0 * rng.uniform_float() as f64) as f32;
+                let hair = HairBsdf::new(h, 1.55, Spectrum::ZERO, beta_m, beta_n, 0.0);
+                let wi = uniform_sample_sphere(rng.uniform_2d());
+                sum += hair.f(wo, wi) * wi.z.abs();
+            }
+            let avg = crate::spectrum_luminance(sum) / (count as f32 * UNIFORM_SPHERE_PDF);
+            assert!((0.95..=1.05).contains(&avg), "{beta_m} {beta_n}: {avg}");
+        });
+    }
+
+    /// pbrt-v3's `Hair.WhiteFurnaceSampled`: the same with importance sampling, within 1%.
+    #[test]
+    fn white_furnace_sampled() {
+        let mut rng = PbrtRng::new();
+        let wo = uniform_sample_sphere(rng.uniform_2d());
+        beta_loops(0.1, 0.1, |beta_m, beta_n| {
+            let count = 300_000;
+            let mut sum = Spectrum::ZERO;
+            for _ in 0..count {
+                let h = (-1.0 + 2.0 * rng.uniform_float() as f64) as f32;
+                let hair = HairBsdf::new(h, 1.55, Spectrum::ZERO, beta_m, beta_n, 0.0);
+                let (wi, f, pdf) = hair.sample_f(wo, rng.uniform_2d());
+                if pdf > 0.0 {
+                    sum += f * wi.z.abs() / pdf;
+                }
+            }
+            let avg = crate::spectrum_luminance(sum) / count as f32;
+            assert!((0.99..=1.01).contains(&avg), "{beta_m} {beta_n}: {avg}");
+        });
+    }
+
+    /// pbrt-v3's `Hair.SamplingWeights`: without absorption, every sample's weight
+    /// f |cos| / pdf is 1 (the sampling density is proportional to f).
+    #[test]
+    fn sampling_weights_are_one() {
+        let mut rng = PbrtRng::new();
+        beta_loops(0.1, 0.4, |beta_m, beta_n| {
+            for _ in 0..10_000 {
+                let h = -1.0 + 2.0 * rng.uniform_float();
+                let hair = HairBsdf::new(h, 1.55, Spectrum::ZERO, beta_m, beta_n, 0.0);
+                let wo = uniform_sample_sphere(rng.uniform_2d());
+                let (wi, f, pdf) = hair.sample_f(wo, rng.uniform_2d());
+                if pdf > 0.0 {
+                    let w = crate::spectrum_luminance(f) * wi.z.abs() / pdf;
+                    assert!(w > 0.999 && w < 1.001, "{beta_m} {beta_n} {h} {wo}: {w}");
+                }
+            }
+        });
+    }
+
+    /// pbrt-v3's `Hair.SamplingConsistency`: with absorption, importance sampling and uniform
+    /// sampling estimate the same light scattered from an environment of z² (within 5%).
+    #[test]
+    fn sampling_is_consistent_with_evaluation() {
+        let mut rng = PbrtRng::new();
+        beta_loops(0.2, 0.4, |beta_m, beta_n| {
+            let count = 64 * 1024;
+            let sigma_a = Spectrum::splat(0.25);
+            let wo = uniform_sample_sphere(rng.uniform_2d());
+            let li = |w: Vec3| w.z * w.z;
+            let (mut importance, mut uniform) = (Spectrum::ZERO, Spectrum::ZERO);
+            for _ in 0..count {
+                let h = -1.0 + 2.0 * rng.uniform_float();
+                let hair = HairBsdf::new(h, 1.55, sigma_a, beta_m, beta_n, 0.0);
+                let u = rng.uniform_2d();
+                let (wi, f, pdf) = hair.sample_f(wo, u);
+                if pdf > 0.0 {
+                    importance += f * li(wi) * wi.z.abs() / (count as f32 * pdf);
+                }
+                let wi = uniform_sample_sphere(u);
+                uniform +=
+                    hair.f(wo, wi) * li(wi) * wi.z.abs() / (count as f32 * UNIFORM_SPHERE_PDF);
+            }
+            let (a, b) = (
+                crate::spectrum_luminance(importance),
+                crate::spectrum_luminance(uniform),
+            );
+            assert!((a - b).abs() / b < 0.05, "{beta_m} {beta_n}: {a} vs {b}");
+        });
+    }
+
+    /// The lobe adds no size to acr's `Bxdf` (held by value, eight to a BSDF): it is no larger
+    /// than the fields of `MicrofacetReflection` (r, distribution, conductor Fresnel), the
+    /// largest of the other lobes (60 bytes; `Bxdf` is 64).
+    #[test]
+    fn lobe_keeps_bxdf_small() {
+        use crate::bsdf::Fresnel;
+        use crate::microfacet::TrowbridgeReitz;
+        let microfacet = std::mem::size_of::<(Spectrum, TrowbridgeReitz, Fresnel)>();
+        assert!(std::mem::size_of::<HairBsdf>() <= microfacet);
+    }
+
+    /// Degenerate directions and parameters give finite values or NaN, never a panic or a hang;
+    /// the BSDF then turns non-finite values into nothing.
+    #[test]
+    fn degenerate_inputs_neither_panic_nor_hang() {
+        let dirs = [
+            Vec3::X,
+            -Vec3::X,
+            Vec3::Z,
+            Vec3::ZERO,
+            Vec3::new(1.0, 0.0, 1e-7),
+        ];
+        for (h, bm, bn) in [
+            (1.0, 0.3, 0.3),
+            (-1.0, 0.0, 0.0),
+            (2.0, 1.0, 1.0),
+            (0.3, 0.3, 0.3),
+        ] {
+            let hair = HairBsdf::new(h, 1.55, Spectrum::splat(0.5), bm, bn, 2.0);
+            for wo in dirs {
+                for wi in dirs {
+                    let _ = (hair.f(wo, wi), hair.pdf(wo, wi));
+                }
+                for u in [Vec2::ZERO, Vec2::splat(0.5), Vec2::ONE, Vec2::splat(-1.0)] {
+                    let _ = hair.sample_f(wo, u);
+                }
+            }
+        }
+        assert_eq!(demux_float(1.0), demux_float(1.0 - f32::EPSILON / 2.0));
+    }
+
+    /// A hit on a curve: the tangent (dp/du) along y, the normal along z, v across the hair.
+    fn curve_hit(v: f32) -> SurfaceInteraction {
+        SurfaceInteraction {
+            p: Vec3::ZERO,
+            n: Vec3::Z,
+            uv: Vec2::new(0.4, v),
+            dpdu: Vec3::new(0.0, 2.0, 0.0),
+            dpdv: Vec3::new(-0.1, 0.0, 0.0),
+            shading_n: Vec3::Z,
+            shading_dpdu: Vec3::new(0.0, 2.0, 0.0),
+            shading_dpdv: Vec3::new(-0.1, 0.0, 0.0),
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
+            wo: Vec3::Z,
+            time: 0.0,
+            p_error: 0.0,
+        }
+    }
+
+    /// Parses world-block text and builds its materials (every one used by a sphere).
+    fn build(text: &str) -> Result<(Vec<Material>, Vec<Warning>, Vec<Warning>)> {
+        let full = format!("WorldBegin\n{text}\nShape \"sphere\"\nWorldEnd\n");
+        let desc = parse_str(&full, Path::new("/tmp/scene.pbrt")).unwrap();
+        let mut w = Vec::new();
+        let m = build_materials(&desc, Path::new("/tmp"), glam::DMat4::IDENTITY, &mut w)?;
+        Ok((m, w, desc.unused_parameter_warnings()))
+    }
+
+    fn hair_of(m: &[Material]) -> &HairMaterial {
+        match m.last() {
+            Some(Material::Hair(h)) => h,
+            other => panic!("not hair: {other:?}"),
+        }
+    }
+
+    /// The BSDF's frame is pbrt-v3's: x along the hair's dp/du, z the shading normal, y their
+    /// cross product (n x s); h = -1 + 2 v; the relative index is eta.
+    #[test]
+    fn material_lobe_is_in_the_hair_frame() {
+        let (m, w, _) = build(r#"Material "hair" "float eta" 1.6"#).unwrap();
+        assert!(w.is_empty(), "{w:?}");
+        let si = curve_hit(0.3);
+        let bsdf = m.last().unwrap().bsdf(&si);
+        assert_eq!(bsdf.num_lobes(), 1);
+        assert!((bsdf.eta() - 1.6).abs() < 1e-6);
+        let want = HairBsdf::new(
+            -0.4,
+            1.6,
+            sigma_a_from_concentration(1.3, 0.0),
+            0.3,
+            0.3,
+            2.0,
+        );
+        let Bxdf::Hair(got) = bsdf.lobes()[0].bxdf else {
+            panic!()
+        };
+        assert!((got.h - want.h).abs() < 1e-6);
+        assert_eq!(
+            HairBsdf {
+                h: want.h,
+                gamma_o: want.gamma_o,
+                ..got
+            },
+            want
+        );
+        let (ss, ns) = (Vec3::Y, Vec3::Z);
+        let ts = ns.cross(ss);
+        let local = |v: Vec3| Vec3::new(v.dot(ss), v.dot(ts), v.dot(ns));
+        let mut rng = Rng::new(9);
+        for _ in 0..100 {
+            let wo = uniform_sample_sphere(rng.next_2d());
+            let wi = uniform_sample_sphere(rng.next_2d());
+            if wo.z == 0.0 {
+                continue;
+            }
+            let (a, b) = (bsdf.f(wo, wi), got.f(local(wo), local(wi)));
+            assert!(
+                (a - b).abs().max_element() <= 1e-4 * b.max_element() + 1e-7,
+                "{a} {b}"
+            );
+            let (a, b) = (bsdf.pdf(wo, wi), got.pdf(local(wo), local(wi)));
+            assert!((a - b).abs() <= 1e-4 * b + 1e-7, "{a} {b}");
+        }
+    }
+
+    /// pbrt-v3's precedence: sigma_a, else color, else the melanins, else eumelanin 1.3; each
+    /// parameter that loses warns at its location, and the defaults are pbrt-v3's.
+    #[test]
+    fn absorption_follows_pbrt_v3_precedence() {
+        let si = curve_hit(0.5);
+        let sigma_of = |m: &[Material]| hair_of(m).bxdf(&si).0.sigma_a;
+
+        let (m, w, _) = build(r#"Material "hair""#).unwrap();
+        assert!(w.is_empty(), "{w:?}");
+        let h = hair_of(&m);
+        assert_eq!(
+            h.sigma_a.as_ref().and_then(Texture::as_constant),
+            Some(sigma_a_from_concentration(1.3, 0.0))
+        );
+        assert!(h.color.is_none() && h.eumelanin.is_none() && h.pheomelanin.is_none());
+        let consts = [&h.eta, &h.beta_m, &h.beta_n, &h.alpha].map(|t| t.as_constant());
+        assert_eq!(consts, [Some(1.55), Some(0.3), Some(0.3), Some(2.0)]);
+
+        let (m, w, _) = build(
+            r#"Material "hair" "rgb sigma_a" [0.1 -0.2 0.3] "rgb color" [0.5 0.5 0.5]
+               "float eumelanin" 2 "float pheomelanin" 1"#,
+        )
+        .unwrap();
+        assert_eq!(w.len(), 3, "{w:?}");
+        for (warning, name) in w.iter().zip(["color", "eumelanin", "pheomelanin"]) {
+            assert_eq!(
+                warning.message,
+                format!("Ignoring \"{name}\" parameter since \"sigma_a\" was provided.")
+            );
+            assert!(warning.loc.is_some());
+        }
+        // Negative absorption is clamped to zero, as pbrt-v3's Spectrum::Clamp.
+        assert_eq!(sigma_of(&m), Spectrum::new(0.1, 0.0, 0.3));
+
+        let (m, w, _) = build(
+            r#"Material "hair" "rgb color" [0.3 0.2 0.1] "float beta_n" 0.5
+               "float pheomelanin" 1"#,
+        )
+        .unwrap();
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0]
+            .message
+            .contains("\"pheomelanin\" parameter since \"color\""));
+        let want = sigma_a_from_reflectance(Spectrum::new(0.3, 0.2, 0.1), 0.5);
+        assert_eq!(sigma_of(&m), want);
+        // The albedo feature gives the colour back.
+        let a = hair_of(&m).bxdf(&si).0.albedo();
+        assert!(
+            (a - Spectrum::new(0.3, 0.2, 0.1)).abs().max_element() < 1e-5,
+            "{a}"
+        );
+
+        let (m, w, _) = build(r#"Material "hair" "float pheomelanin" 0.8"#).unwrap();
+        assert!(w.is_empty(), "{w:?}");
+        assert_eq!(sigma_of(&m), sigma_a_from_concentration(0.0, 0.8));
+        let (m, _, _) =
+            build(r#"Material "hair" "float eumelanin" -1 "float pheomelanin" 2"#).unwrap();
+        assert_eq!(sigma_of(&m), sigma_a_from_concentration(0.0, 2.0));
+
+        // Textured parameters are evaluated at the hit.
+        let (m, w, _) = build(
+            r#"Texture "e" "float" "constant" "float value" 0.4
+               Texture "c" "spectrum" "constant" "rgb value" [0.6 0.5 0.4]
+               Material "hair" "texture eumelanin" "e" "texture beta_m" "e""#,
+        )
+        .unwrap();
+        assert!(w.is_empty(), "{w:?}");
+        assert_eq!(sigma_of(&m), sigma_a_from_concentration(0.4, 0.0));
+        assert_eq!(
+            hair_of(&m).bxdf(&si).0.v0,
+            HairBsdf::new(0.0, 1.55, Spectrum::ZERO, 0.4, 0.3, 2.0).v0
+        );
+    }
+
+    /// Constants on which pbrt-v3 aborts are located errors; a bumpmap is not read (pbrt-v3's
+    /// hair has none), so it is reported unused; hair mixes like any material.
+    #[test]
+    fn bad_parameters_fail_and_bumpmap_is_unused() {
+        for (param, what) in [
+            (r#""float beta_m" 0"#, "beta_m"),
+            (r#""float beta_m" 1.5"#, "beta_m"),
+            (r#""float beta_n" -0.1"#, "beta_n"),
+            (r#""float eta" 0.9"#, "eta"),
+        ] {
+            let e = build(&format!("Material \"hair\" {param}")).unwrap_err();
+            assert!(matches!(e, Error::At { .. }), "{e}");
+            assert!(e.message().contains(&format!("hair \"{what}\"")), "{e}");
+        }
+        let (m, w, unused) = build(
+            r#"Texture "b" "float" "constant" "float value" 0.1
+               Material "hair" "texture bumpmap" "b" "float beta_m" 1"#,
+        )
+        .unwrap();
+        assert!(w.is_empty(), "{w:?}");
+        assert!(matches!(m.last(), Some(Material::Hair(_))));
+        assert!(
+            unused.iter().any(|u| u.message.contains("bumpmap")),
+            "{unused:?}"
+        );
+
+        let (m, _, _) = build(
+            r#"MakeNamedMaterial "a" "string type" "hair"
+               MakeNamedMaterial "b" "string type" "matte"
+               MakeNamedMaterial "m" "string type" "mix" "string namedmaterial1" "a"
+                 "string namedmaterial2" "b"
+               NamedMaterial "m""#,
+        )
+        .unwrap();
+        let b: Bsdf = m.last().unwrap().bsdf(&curve_hit(0.5));
+        assert_eq!(b.num_lobes(), 2);
+        assert!(matches!(b.lobes()[0].bxdf, Bxdf::Hair(_)));
+        assert!((b.eta() - 1.55).abs() < 1e-6);
+    }
+}
