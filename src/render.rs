@@ -63,9 +63,22 @@ pub fn in_pixel(px: u32, py: u32, u: Vec2) -> Vec2 {
     p.min(Vec2::new(below(px + 1), below(py + 1)))
 }
 
+/// A write of the image so far, every `every` of render time (`--write-partial-images`).
+pub struct Checkpoint<'a> {
+    /// How often.
+    pub every: Duration,
+    /// Writes the film's image.
+    pub write: &'a (dyn Fn(&Film) + Sync),
+}
+
 /// When a render stops before its sampler's budget is spent.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Stop {
+#[derive(Default)]
+pub struct Stop<'a> {
+    /// Stop (at the end of the pass under way) once this is set: the signal handler of
+    /// SIGINT and SIGTERM sets it.
+    pub interrupt: Option<&'a std::sync::atomic::AtomicBool>,
+    /// Write the image so far now and then.
+    pub checkpoint: Option<Checkpoint<'a>>,
     /// Stop once this much render time has passed (at the end of the pass under way).
     pub time_limit: Option<Duration>,
     /// Stop once the image's estimated relative error ([`relative_error`]) is below this (at
@@ -76,7 +89,7 @@ pub struct Stop {
     pub min_spp: u32,
 }
 
-impl Stop {
+impl Stop<'_> {
     /// A time limit alone.
     pub fn time(limit: Option<Duration>) -> Self {
         Self {
@@ -93,6 +106,8 @@ pub enum Halt {
     Time,
     /// The image's estimated relative error fell below the noise threshold.
     Noise,
+    /// SIGINT or SIGTERM arrived.
+    Signal,
 }
 
 impl Halt {
@@ -101,6 +116,7 @@ impl Halt {
         match self {
             Halt::Time => "time",
             Halt::Noise => "noise",
+            Halt::Signal => "signal",
         }
     }
 }
@@ -326,6 +342,7 @@ pub fn render_with(
     // from `min_spp` on.
     let pixels = space.pixels().max(1);
     let mut next_check = pixels * u64::from(stop.min_spp.max(2));
+    let mut last_checkpoint = Instant::now();
     let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
     while more {
         // While `batch` is traced, the sampler and the film take the batch before and, when
@@ -346,8 +363,21 @@ pub fn render_with(
         if let Some(p) = progress {
             p.set_position(counts.samples);
         }
+        if let Some(c) = &stop.checkpoint {
+            if last_checkpoint.elapsed() >= c.every {
+                // The film holds what the sampler has handed over so far.
+                (c.write)(film);
+                last_checkpoint = Instant::now();
+            }
+        }
         if counts.halted_by.is_none() {
-            if stop.time_limit.is_some_and(|t| start.elapsed() >= t) {
+            if stop
+                .interrupt
+                .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+            {
+                counts.halted_by = Some(Halt::Signal);
+                sampler.halt();
+            } else if stop.time_limit.is_some_and(|t| start.elapsed() >= t) {
                 counts.halted_by = Some(Halt::Time);
                 sampler.halt();
             } else if let Some(threshold) = stop.noise_threshold {

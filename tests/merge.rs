@@ -185,3 +185,58 @@ fn cropwindow_places_the_crop_and_bad_crops_fail_cleanly() {
     fails(&["merge", s(&m), s(&a), s(&d)], "frame");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// SIGTERM (what a scheduler sends before it kills) ends the render at the end of the pass
+/// under way: the image so far is written, the exit status is non-zero with a message. With
+/// `--write-partial-images` the output appears while the render runs (written atomically).
+#[test]
+fn sigterm_writes_the_image_so_far_and_fails() {
+    let dir = temp_dir("signal");
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.pbrt");
+    let out = dir.join("partial.exr");
+    let child = Command::new(env!("CARGO_BIN_EXE_acr"))
+        .args([
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--spp",
+            "65536",
+            "--quiet",
+        ])
+        .args(["--threads", "1", "--write-partial-images", "0.2"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !out.exists() {
+        assert!(
+            start.elapsed().as_secs() < 120,
+            "no partial image after two minutes"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let (img, _) = read_image_with_frame(&out).unwrap();
+    assert_eq!((img.width, img.height), (256, 256));
+    // SAFETY: kill(2) on our own child's pid, with a valid signal number.
+    let rc = unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    assert_eq!(rc, 0);
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && output.status.code().is_some(),
+        "{err}"
+    );
+    assert!(err.contains("interrupted by a signal"), "{err}");
+    let (img, _) = read_image_with_frame(&out).unwrap();
+    let mean: f32 =
+        img.pixels.iter().map(|c| c.x + c.y + c.z).sum::<f32>() / img.pixels.len() as f32;
+    assert!(mean > 0.01 && mean.is_finite(), "mean {mean}");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -8,12 +8,14 @@ use crate::features::FeatureImage;
 use crate::image_io::{write_image_in_frame, Frame, RgbImage};
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
-use crate::render::{render, render_with_features, Halt, Stop, MAX_SPP};
+use crate::render::{render, render_with_features, Checkpoint, Halt, Stop, MAX_SPP};
 use crate::scene::Scene;
 use acr_parser::SceneDescription;
 use acr_plugins::{Film, SamplePoint, Sampler, Setting};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Arguments of `acr render`.
@@ -84,6 +86,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_window,
           conflicts_with = "pixelbounds")]
     pub cropwindow: Option<[f64; 4]>,
+    /// Write the image so far to the output every SECONDS of rendering (default 10), atomically
+    /// (a temporary file, then a rename), as pbrt-v4's --write-partial-images. With a
+    /// splatting filter it is the image; a reconstruction's fit runs only at the end.
+    #[arg(long, value_name = "SECONDS", num_args = 0..=1, default_missing_value = "10",
+          value_parser = parse_seconds)]
+    pub write_partial_images: Option<f64>,
     /// Render only the pixels [X0, X1) x [Y0, Y1) (pbrt-v4's --pixelbounds; overrides the
     /// Film's cropwindow).
     #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_bounds)]
@@ -324,10 +332,41 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     } else {
         recording.inner()
     };
+    // SIGINT and SIGTERM (what a scheduler sends before it kills) end the render at the end
+    // of the pass under way; a second one exits at once.
+    let interrupted = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(signal, 1, Arc::clone(&interrupted))
+            .and_then(|_| signal_hook::flag::register(signal, Arc::clone(&interrupted)))
+            .map_err(|e| format!("cannot watch for signals: {e}"))?;
+    }
+    let frame = Frame {
+        width: scene.film.resolution.0 as usize,
+        height: scene.film.resolution.1 as usize,
+        x0: scene.film.crop[0] as usize,
+        y0: scene.film.crop[2] as usize,
+    };
+    let (w, h) = scene.film.size();
+    let write_partial = |film: &Film| {
+        let scale = film.settings().scale;
+        let image = RgbImage {
+            width: w as usize,
+            height: h as usize,
+            pixels: film.pixels().into_iter().map(|c| c * scale).collect(),
+        };
+        if let Err(e) = write_atomically(&output, &image, frame) {
+            eprintln!("warning: partial image: {e}");
+        }
+    };
     let stop = Stop {
         time_limit: args.time_limit.map(std::time::Duration::from_secs_f64),
         noise_threshold: args.noise_threshold,
         min_spp: args.min_spp,
+        interrupt: Some(&interrupted),
+        checkpoint: args.write_partial_images.map(|s| Checkpoint {
+            every: std::time::Duration::from_secs_f64(s),
+            write: &write_partial,
+        }),
     };
     let mut features = aovs.iter().any(AovRequest::is_feature).then(|| {
         let [x0, x1, y0, y1] = scene.film.crop;
@@ -376,7 +415,6 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     // The measure's renders are no part of the reconstruction.
     let t_measured = Instant::now();
 
-    let (w, h) = scene.film.size();
     let image = RgbImage {
         width: w as usize,
         height: h as usize,
@@ -384,14 +422,7 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     };
     let t_reconstructed = Instant::now();
     let fit_partition = plugins.filter.fit_partition();
-    let frame = Frame {
-        width: scene.film.resolution.0 as usize,
-        height: scene.film.resolution.1 as usize,
-        x0: scene.film.crop[0] as usize,
-        y0: scene.film.crop[2] as usize,
-    };
-    write_image_in_frame(&output, &image, frame)
-        .map_err(|e| format!("{}: {e}", output.display()))?;
+    write_atomically(&output, &image, frame)?;
     for a in &aovs {
         let line = write_aov(
             a,
@@ -460,6 +491,14 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             counts.dropped, counts.samples
         );
     }
+    if counts.halted_by == Some(Halt::Signal) {
+        return Err(format!(
+            "interrupted by a signal after {} of {spp} samples per pixel; the image so far is in \
+             {} (render the rest and merge, or render again)",
+            counts.samples / (u64::from(w) * u64::from(h)).max(1),
+            output.display()
+        ));
+    }
     if counts.halted && !args.quiet {
         let why = match counts.halted_by {
             Some(Halt::Noise) => "noise threshold",
@@ -482,6 +521,23 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// Writes `image` to `output` through a temporary file in the same folder and a rename, so
+/// that a reader (or a kill mid-write) never sees half a file.
+fn write_atomically(output: &Path, image: &RgbImage, frame: Frame) -> Result<(), String> {
+    let name = output
+        .file_name()
+        .map_or_else(|| "image".into(), |n| n.to_string_lossy().into_owned());
+    let ext = output
+        .extension()
+        .map_or_else(String::new, |e| e.to_string_lossy().into_owned());
+    let temp = output.with_file_name(format!(".{name}.{}.partial.{ext}", std::process::id()));
+    write_image_in_frame(&temp, image, frame).map_err(|e| format!("{}: {e}", temp.display()))?;
+    std::fs::rename(&temp, output).map_err(|e| {
+        let _ = std::fs::remove_file(&temp);
+        format!("{}: cannot write: {e}", output.display())
+    })
 }
 
 /// Fails early, before the render, when the output cannot be written (unknown format or a
