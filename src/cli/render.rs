@@ -92,6 +92,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SECONDS", num_args = 0..=1, default_missing_value = "10",
           value_parser = parse_seconds)]
     pub write_partial_images: Option<f64>,
+    /// A quick look: a quarter of the resolution in each direction and 1 sample per pixel, as
+    /// pbrt-v4's --quick (overrides --spp).
+    #[arg(long, conflicts_with = "sampler_cost")]
+    pub quick: bool,
     /// Render only the pixels [X0, X1) x [Y0, Y1) (pbrt-v4's --pixelbounds; overrides the
     /// Film's cropwindow).
     #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_bounds)]
@@ -240,7 +244,11 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             .build_global()
             .map_err(|e| format!("cannot start {n} threads: {e}"))?;
     }
-    let desc = acr_parser::parse_file(&args.scene).map_err(|e| e.to_string())?;
+    let mut desc = acr_parser::parse_file(&args.scene).map_err(|e| e.to_string())?;
+    if args.quick {
+        quarter_resolution(&mut desc).map_err(|e| e.to_string())?;
+    }
+    let spp = if args.quick { Some(1) } else { args.spp };
     let t_parsed = Instant::now();
 
     let mut warnings = desc.warnings.clone();
@@ -268,15 +276,8 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             .collect::<Result<_, _>>()
             .map_err(|e| e.to_string())?,
     };
-    let mut plugins = choose_for_scene(
-        &desc,
-        &scene,
-        &overrides,
-        args.spp,
-        args.seed,
-        &mut warnings,
-    )
-    .map_err(|e| e.to_string())?;
+    let mut plugins = choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
+        .map_err(|e| e.to_string())?;
     if let Some(a) = &desc.accelerator {
         // acr has one acceleration structure; pbrt-v3's choice of its own is moot.
         for p in a.params.iter() {
@@ -519,6 +520,29 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             stats.threads,
             output.display()
         );
+    }
+    Ok(())
+}
+
+/// `--quick`: the Film's resolution divided by 4 in each direction (at least 1 pixel), as
+/// pbrt-v4 does; a scene without a Film gets pbrt-v3's default 1280x720, quartered.
+fn quarter_resolution(desc: &mut SceneDescription) -> acr_parser::Result<()> {
+    use acr_parser::{Param, ParamList, ParamType, PluginDesc, Values};
+    let loc = match (&desc.film, &desc.camera) {
+        (Some(f), _) => f.loc.clone(),
+        (None, Some(c)) => c.plugin.loc.clone(),
+        (None, None) => return Ok(()),
+    };
+    let film = desc.film.get_or_insert_with(|| PluginDesc {
+        kind: "image".to_owned(),
+        params: ParamList::new(),
+        loc: loc.clone(),
+    });
+    for (name, default) in [("xresolution", 1280), ("yresolution", 720)] {
+        let v = film.params.int_or(name, default)?;
+        let quarter = Values::Ints(vec![(v / 4).max(1)]);
+        film.params
+            .push(Param::new(ParamType::Integer, name, quarter, loc.clone()));
     }
     Ok(())
 }

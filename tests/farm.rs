@@ -1,5 +1,6 @@
-//! Crops that tile a frame (`acr render --cropwindow` / `--pixelbounds`) and `acr merge`: the
-//! EXR's display and data windows, and merges equal to the whole-frame render byte for byte.
+//! What a render farm needs (issue 28): crops that tile a frame (`acr render --cropwindow` /
+//! `--pixelbounds`) and `acr merge` (the EXR's display and data windows, merges equal to the
+//! whole-frame render byte for byte), clean stops on SIGTERM with partial writes, `--quick`.
 
 use acr::image_io::read_image_with_frame;
 use std::path::{Path, PathBuf};
@@ -238,5 +239,31 @@ fn sigterm_writes_the_image_so_far_and_fails() {
         .map(|e| e.file_name())
         .collect();
     assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--quick`: a quarter of the resolution in each direction and 1 sample per pixel.
+#[test]
+fn quick_renders_a_quarter_resolution_at_one_sample() {
+    let dir = temp_dir("quick");
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.pbrt");
+    let (out, stats) = (dir.join("quick.exr"), dir.join("quick.json"));
+    ok(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--quick",
+        "-q",
+        "--stats",
+        s(&stats),
+    ]);
+    let (img, frame) = read_image_with_frame(&out).unwrap();
+    assert_eq!((img.width, img.height, frame.width), (64, 64, 64));
+    let stats: String = std::fs::read_to_string(&stats).unwrap();
+    assert!(
+        stats.contains("\"spp\":1,") || stats.contains("\"spp\": 1,"),
+        "{stats}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
