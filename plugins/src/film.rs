@@ -638,6 +638,13 @@ impl Film {
         &self.stats
     }
 
+    /// Each pixel's filter-weighted sums of radiance and its sum of filter weights, [r, g, b,
+    /// w], row-major: what renders of different sample ranges add to merge (`None` when the
+    /// streams are split: the image is then a mean of two films).
+    pub fn weighted_sums(&self) -> Option<&[[f64; 4]]> {
+        self.halves.is_none().then_some(self.sums.as_slice())
+    }
+
     /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
     /// `scale` is applied on output, not here).
     pub fn pixels(&self) -> Vec<Spectrum> {

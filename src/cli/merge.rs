@@ -1,8 +1,11 @@
-//! `acr merge OUT INPUTS...`: crops of one frame, rendered apart (`--cropwindow`,
-//! `--pixelbounds`, or a Film cropwindow), placed by their EXR data windows into the whole
-//! frame, as pbrt-v4's `imgtool assemble` does. Every pixel of the frame must come from exactly
-//! one input.
+//! `acr merge OUT INPUTS...`: either sample ranges of one crop (mergeable EXRs from
+//! `acr render --mergeable --sample-offset K`), whose weighted sums add up to the render of all
+//! their samples, or crops of one frame, rendered apart (`--cropwindow`, `--pixelbounds`, or a
+//! Film cropwindow), placed by their EXR data windows into the whole frame, as pbrt-v4's
+//! `imgtool assemble` does (every pixel of the frame from exactly one input).
 
+use super::mergeable::Sums;
+use crate::geometry::Spectrum;
 use crate::image_io::{read_image_with_frame, write_image, Frame, RgbImage};
 use std::path::{Path, PathBuf};
 
@@ -10,6 +13,34 @@ use std::path::{Path, PathBuf};
 pub fn command(output: &Path, inputs: &[PathBuf]) -> Result<(), String> {
     if inputs.is_empty() {
         return Err("acr merge needs at least one input image".to_owned());
+    }
+    let read = |p: &PathBuf| Sums::read(p).map_err(|e| format!("{}: {e}", p.display()));
+    let first = if extension_is_exr(&inputs[0]) {
+        read(&inputs[0])?
+    } else {
+        None
+    };
+    if let Some(mut total) = first {
+        if inputs.len() > 1 && inputs.iter().all(|p| p == &inputs[0]) {
+            return Err("the same sample range given more than once".to_owned());
+        }
+        let same_crop =
+            |s: &Sums| (s.frame, s.width, s.height) == (total.frame, total.width, total.height);
+        let ranges = inputs[1..]
+            .iter()
+            .map(|p| Ok((p, read(p)?)))
+            .collect::<Result<Vec<_>, String>>()?;
+        if ranges
+            .iter()
+            .all(|(_, s)| s.as_ref().is_some_and(same_crop))
+        {
+            for (p, s) in &ranges {
+                if let Some(s) = s {
+                    total.add(s).map_err(|e| format!("{}: {e}", p.display()))?;
+                }
+            }
+            return write_sums(output, &total);
+        }
     }
     let mut frame: Option<Frame> = None;
     let mut image = RgbImage::new(0, 0);
@@ -61,5 +92,29 @@ pub fn command(output: &Path, inputs: &[PathBuf]) -> Result<(), String> {
             i / w
         ));
     }
+    write_image(output, &image).map_err(|e| format!("{}: {e}", output.display()))
+}
+
+fn extension_is_exr(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// Writes merged sample ranges: a mergeable EXR again (so merges chain), or the image alone
+/// in another format.
+fn write_sums(output: &Path, total: &Sums) -> Result<(), String> {
+    if extension_is_exr(output) {
+        return total
+            .write(output)
+            .map_err(|e| format!("{}: {e}", output.display()));
+    }
+    let image = RgbImage {
+        width: total.width,
+        height: total.height,
+        pixels: total
+            .image()
+            .into_iter()
+            .map(|[r, g, b]| Spectrum::new(r, g, b))
+            .collect(),
+    };
     write_image(output, &image).map_err(|e| format!("{}: {e}", output.display()))
 }

@@ -9,6 +9,7 @@ pub mod aov;
 pub mod bench;
 pub mod diff;
 pub mod merge;
+pub mod mergeable;
 pub mod parse;
 pub mod render;
 pub mod replay;

@@ -2,6 +2,7 @@
 
 use super::{parse_seconds, parse_threshold};
 use crate::cli::aov::{parse_aovs, write_aov, AovRequest};
+use crate::cli::mergeable::Sums;
 use crate::cli::replay::{Recording, Replay};
 use crate::cli::stats::{median, peak_rss_mb, Seconds, Stats};
 use crate::features::FeatureImage;
@@ -92,6 +93,16 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SECONDS", num_args = 0..=1, default_missing_value = "10",
           value_parser = parse_seconds)]
     pub write_partial_images: Option<f64>,
+    /// Render sample indices K to K + spp of each pixel instead of 0 to spp (Cycles' sample
+    /// offset): ranges rendered apart with --mergeable merge (`acr merge`) into the render of
+    /// them all. Samplers whose points depend on the index alone (random, sobol).
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub sample_offset: u32,
+    /// Write an EXR that `acr merge` can combine with renders of other sample ranges: beside
+    /// R, G, B, each pixel's weighted radiance sums, filter-weight sum and sample count, and
+    /// the header attributes samplesPerPixel and renderTimeSeconds (pbrt-v4's names).
+    #[arg(long)]
+    pub mergeable: bool,
     /// A quick look: a quarter of the resolution in each direction and 1 sample per pixel, as
     /// pbrt-v4's --quick (overrides --spp).
     #[arg(long, conflicts_with = "sampler_cost")]
@@ -278,6 +289,30 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     };
     let mut plugins = choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
         .map_err(|e| e.to_string())?;
+    if args.sample_offset > 0 {
+        let fits = plugins
+            .sampler
+            .spp()
+            .checked_add(args.sample_offset)
+            .is_some();
+        if !fits || !plugins.sampler.set_sample_offset(args.sample_offset) {
+            return Err(format!(
+                "--sample-offset {}: the {} sampler cannot start its samples there (sample \
+                 ranges need a sampler whose points depend on the index alone: random or sobol)",
+                args.sample_offset,
+                plugins.sampler.name()
+            ));
+        }
+    }
+    let splats = plugins.filter.cell_layout().is_none() && !plugins.sampler.reconstructs();
+    if args.mergeable && (!splats || plugins.sampler.streams() > 1) {
+        return Err(format!(
+            "--mergeable needs a splatting filter (box, gaussian, mitchell, sinc, triangle) and \
+             a sampler that does not reconstruct the image itself, not {} + {}",
+            plugins.sampler.name(),
+            plugins.filter.name()
+        ));
+    }
     if let Some(a) = &desc.accelerator {
         // acr has one acceleration structure; pbrt-v3's choice of its own is moot.
         for p in a.params.iter() {
@@ -294,6 +329,16 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         }
     }
     let output = output_path(args, scene.film.filename.as_deref());
+    if args.mergeable
+        && !output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        return Err(format!(
+            "--mergeable writes an EXR, not {}",
+            output.display()
+        ));
+    }
     check_writable(&output)?;
     let aovs: Vec<AovRequest> = args
         .aov
@@ -423,7 +468,33 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     };
     let t_reconstructed = Instant::now();
     let fit_partition = plugins.filter.fit_partition();
-    write_atomically(&output, &image, frame)?;
+    if args.mergeable {
+        let scale = f64::from(scene.film.scale);
+        let sums = film
+            .weighted_sums()
+            .ok_or("--mergeable: the film has no sums")?;
+        let merged = Sums {
+            frame,
+            width: w as usize,
+            height: h as usize,
+            sums: sums
+                .iter()
+                .map(|s| [s[0] * scale, s[1] * scale, s[2] * scale, s[3]])
+                .collect(),
+            counts: film
+                .pixel_stats()
+                .iter()
+                .map(|p| f64::from(p.count))
+                .collect(),
+            spp,
+            seconds: (t_rendered - t_built).as_secs_f64(),
+        };
+        merged
+            .write(&output)
+            .map_err(|e| format!("{}: {e}", output.display()))?;
+    } else {
+        write_atomically(&output, &image, frame)?;
+    }
     for a in &aovs {
         let line = write_aov(
             a,

@@ -83,6 +83,9 @@ impl HaltonSampler {
 
 impl PixelPattern for HaltonSampler {
     const NAME: &'static str = "halton";
+    // Its scramble keeps as many exact digits as the sample count needs: index i's point
+    // depends on spp, so a range of indices is not a slice of a longer render.
+    const PROGRESSIVE: bool = false;
 
     fn cursor(&self) -> &PixelCursor {
         &self.cursor

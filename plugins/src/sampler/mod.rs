@@ -82,6 +82,13 @@ pub trait Sampler: Send {
         false
     }
 
+    /// Gives sample indices `offset` to `offset + spp` of each pixel instead of 0 to `spp`
+    /// (Cycles' sample offset), so that renders of consecutive ranges add up to one of them
+    /// all. Only a sampler whose points depend on the index alone can; it says whether it did.
+    fn set_sample_offset(&mut self, offset: u32) -> bool {
+        offset == 0
+    }
+
     /// The sampler's clusters, for the reconstruction, when it has any.
     fn partition(&self) -> Option<&Partition> {
         None
@@ -241,6 +248,8 @@ pub(crate) const PIXELSAMPLES_ON_AVERAGE: crate::registry::ParamSpec =
 pub(crate) struct PixelCursor {
     space: RenderingSpace,
     spp: u32,
+    /// The first sample index given ([`Sampler::set_sample_offset`]).
+    offset: u32,
     pass_len: u32,
     pass_start: u32,
     next_pixel: u64,
@@ -254,6 +263,7 @@ impl PixelCursor {
         Self {
             space,
             spp,
+            offset: 0,
             pass_len: (BATCH_SAMPLES / pixels).clamp(1, u64::from(spp.max(1))) as u32,
             pass_start: 0,
             next_pixel: 0,
@@ -287,7 +297,8 @@ impl PixelCursor {
         // A pixel with more than a batch's samples forms a batch alone.
         let per_batch = (BATCH_SAMPLES / u64::from(n)).max(1);
         let end = (self.next_pixel + per_batch).min(total);
-        let batch = (self.next_pixel..end, self.pass_start..self.pass_start + n);
+        let first = self.pass_start.saturating_add(self.offset);
+        let batch = (self.next_pixel..end, first..first.saturating_add(n));
         self.next_pixel = end;
         if end == total {
             self.next_pixel = 0;
@@ -327,6 +338,10 @@ pub(crate) trait PixelPattern: Send + Sync {
 
     /// Appends the points with sample indices `indices` of pixel `p` to `out`.
     fn pixel(&self, p: [u32; 2], indices: Range<u32>, out: &mut Vec<SamplePoint>);
+
+    /// Whether a point depends on its index alone, not on the pixel's sample count (so that a
+    /// range of indices can start anywhere: [`Sampler::set_sample_offset`]).
+    const PROGRESSIVE: bool;
 }
 
 impl<T: PixelPattern> Sampler for T {
@@ -370,6 +385,14 @@ impl<T: PixelPattern> Sampler for T {
 
     fn plans_ahead(&self) -> bool {
         // Its points depend on nothing it observes.
+        true
+    }
+
+    fn set_sample_offset(&mut self, offset: u32) -> bool {
+        if offset != 0 && !T::PROGRESSIVE {
+            return false;
+        }
+        self.cursor_mut().offset = offset;
         true
     }
 }

@@ -28,6 +28,7 @@ impl RandomSampler {
 
 impl PixelPattern for RandomSampler {
     const NAME: &'static str = "random";
+    const PROGRESSIVE: bool = true;
 
     fn cursor(&self) -> &PixelCursor {
         &self.cursor

@@ -52,6 +52,7 @@ impl SobolSampler {
 
 impl PixelPattern for SobolSampler {
     const NAME: &'static str = "sobol";
+    const PROGRESSIVE: bool = true;
 
     fn cursor(&self) -> &PixelCursor {
         &self.cursor

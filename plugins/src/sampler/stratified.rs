@@ -89,6 +89,7 @@ impl StratifiedSampler {
 
 impl PixelPattern for StratifiedSampler {
     const NAME: &'static str = "stratified";
+    const PROGRESSIVE: bool = false;
 
     fn cursor(&self) -> &PixelCursor {
         &self.cursor
