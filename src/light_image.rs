@@ -14,6 +14,7 @@
 use crate::geometry::{Spectrum, Vec2, Vec3};
 use crate::image_io::RgbImage;
 use crate::light::{Light, LightSample};
+use crate::texture::{ImageMap, Wrap};
 use glam::{DMat4, Mat4};
 use std::f32::consts::PI;
 
@@ -28,10 +29,9 @@ const HITHER: f32 = 1e-3;
 /// An image a goniometric or projection light scales its intensity by.
 #[derive(Clone, Debug)]
 pub struct LightImage {
-    width: usize,
-    height: usize,
-    /// Top row first, as read (pbrt-v3's MIP map keeps the file's order).
-    pixels: Vec<Spectrum>,
+    /// Top row first, as read (pbrt-v3's MIP map keeps the file's order), wrapped around on
+    /// both axes (pbrt-v3's `ImageWrap::Repeat`).
+    map: ImageMap<Spectrum>,
     /// The mean of the pixels (what pbrt-v3's `Power` looks up, see [`LightImage::average`]).
     average: Spectrum,
 }
@@ -53,9 +53,7 @@ impl LightImage {
         });
         let n = (width * height) as f64;
         Some(Self {
-            width,
-            height,
-            pixels: img.pixels.clone(),
+            map: ImageMap::from_rows(width, height, img.pixels.clone(), Wrap::Repeat),
             average: Spectrum::new(
                 (sum[0] / n) as f32,
                 (sum[1] / n) as f32,
@@ -66,12 +64,12 @@ impl LightImage {
 
     /// Width in pixels.
     pub fn width(&self) -> usize {
-        self.width
+        self.map.width()
     }
 
     /// Height in pixels.
     pub fn height(&self) -> usize {
-        self.height
+        self.map.height()
     }
 
     /// The mean pixel. pbrt-v3's `Power` looks its MIP map up at (0.5, 0.5) with width 0.5,
@@ -84,44 +82,19 @@ impl LightImage {
     /// The mean over the pixels of the largest channel of `intensity` times the pixel (negative
     /// values as 0): the power bound of pbrt-v4's `Bounds` for these lights, per steradian.
     pub fn mean_max(&self, intensity: Spectrum) -> f32 {
-        let sum: f64 = self
-            .pixels
+        let texels = self.map.texels();
+        let sum: f64 = texels
             .iter()
             .map(|p| f64::from((intensity * p.max(Spectrum::ZERO)).max_element()))
             .sum();
-        (sum / self.pixels.len() as f64) as f32
-    }
-
-    /// The pixel at column `s`, row `t` (0 = top), both wrapped around (pbrt-v3's
-    /// `ImageWrap::Repeat`).
-    #[inline]
-    fn texel(&self, s: i64, t: i64) -> Spectrum {
-        let s = s.rem_euclid(self.width as i64) as usize;
-        let t = t.rem_euclid(self.height as i64) as usize;
-        self.pixels[t * self.width + s]
+        (sum / texels.len() as f64) as f32
     }
 
     /// Bilinear interpolation at `st` in [0, 1]², t = 0 at the top row: pbrt-v3's
     /// `MIPMap::Lookup(st)` with no filter width, its bilinear `triangle` at level 0.
     #[inline]
     pub fn lookup(&self, st: Vec2) -> Spectrum {
-        // Keep the integer arithmetic far from overflow; NaN becomes 0.
-        let fix = |v: f32| {
-            if v.is_finite() {
-                v.clamp(-1e9, 1e9)
-            } else {
-                0.0
-            }
-        };
-        let s = fix(st.x * self.width as f32 - 0.5);
-        let t = fix(st.y * self.height as f32 - 0.5);
-        let (s0, t0) = (s.floor(), t.floor());
-        let (ds, dt) = (s - s0, t - t0);
-        let (s0, t0) = (s0 as i64, t0 as i64);
-        self.texel(s0, t0) * ((1.0 - ds) * (1.0 - dt))
-            + self.texel(s0, t0 + 1) * ((1.0 - ds) * dt)
-            + self.texel(s0 + 1, t0) * (ds * (1.0 - dt))
-            + self.texel(s0 + 1, t0 + 1) * (ds * dt)
+        self.map.bilerp(st)
     }
 }
 
@@ -169,7 +142,7 @@ impl ImageProjection {
     pub fn new(map: Option<LightImage>, fov_degrees: f32) -> Self {
         let aspect = map
             .as_ref()
-            .map_or(1.0, |m| m.width as f32 / m.height as f32);
+            .map_or(1.0, |m| m.width() as f32 / m.height() as f32);
         let (screen_lo, screen_hi) = if aspect > 1.0 {
             (Vec2::new(-aspect, -1.0), Vec2::new(aspect, 1.0))
         } else {

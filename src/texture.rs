@@ -279,6 +279,22 @@ impl<T: TexValue> ImageMap<T> {
         }
     }
 
+    /// From texels already in lookup order (row 0 at t = 0), `width` x `height` of them.
+    pub fn from_rows(width: usize, height: usize, texels: Vec<T>, wrap: Wrap) -> Self {
+        debug_assert_eq!(texels.len(), width * height);
+        Self {
+            width,
+            height,
+            texels,
+            wrap,
+        }
+    }
+
+    /// The texels, row 0 first.
+    pub fn texels(&self) -> &[T] {
+        &self.texels
+    }
+
     /// Width in texels.
     pub fn width(&self) -> usize {
         self.width
