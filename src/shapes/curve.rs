@@ -584,13 +584,9 @@ mod tests {
     use super::super::test_util::*;
     use super::*;
     use crate::geometry::Mat4;
-    use acr_parser::parse_str;
-    use std::path::Path;
 
     fn shape_params(text: &str) -> (ParamList, Loc) {
-        let d = parse_str(&format!("WorldBegin {text} WorldEnd"), Path::new("c.pbrt")).unwrap();
-        let s = &d.shapes[0];
-        (s.plugin.params.clone(), s.plugin.loc.clone())
+        super::super::test_util::shape_params(text, "c.pbrt")
     }
 
     /// The three curves of `tests/data/pbrt-v3/curvecheck.cpp`, placed as there.
@@ -624,15 +620,6 @@ mod tests {
                 c
             })
             .collect()
-    }
-
-    #[track_caller]
-    fn close_rel(a: Vec3, b: Vec3, eps: f32, what: &str, line: &str) {
-        let scale = 1.0 + b.abs().max_element();
-        assert!(
-            (a - b).abs().max_element() <= eps * scale,
-            "{what}: {a} != pbrt-v3's {b}\n{line}"
-        );
     }
 
     /// Rays against pbrt-v3's own curves (flat Bézier with tapering width, a reversed cylinder

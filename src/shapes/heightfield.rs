@@ -67,13 +67,9 @@ pub fn mesh_from_params(params: &ParamList, loc: &Loc) -> Result<Mesh> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use acr_parser::parse_str;
-    use std::path::Path;
 
     fn shape_params(text: &str) -> (ParamList, Loc) {
-        let d = parse_str(&format!("WorldBegin {text} WorldEnd"), Path::new("h.pbrt")).unwrap();
-        let s = &d.shapes[0];
-        (s.plugin.params.clone(), s.plugin.loc.clone())
+        super::super::test_util::shape_params(text, "h.pbrt")
     }
 
     #[test]

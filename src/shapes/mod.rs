@@ -248,6 +248,25 @@ pub(crate) mod test_util {
     pub fn close(a: f32, b: f32, eps: f32) {
         assert!((a - b).abs() <= eps, "{a} != {b} (eps {eps})");
     }
+
+    /// Asserts `a` is within `eps` of pbrt-v3's `b`, relative to 1 + |b|'s largest component;
+    /// `line` (the reference data's line) goes in the message.
+    #[track_caller]
+    pub fn close_rel(a: Vec3, b: Vec3, eps: f32, what: &str, line: &str) {
+        let scale = 1.0 + b.abs().max_element();
+        assert!(
+            (a - b).abs().max_element() <= eps * scale,
+            "{what}: {a} != pbrt-v3's {b}\n{line}"
+        );
+    }
+
+    /// The parameters and location of the one shape of `text`, parsed as file `file`.
+    pub fn shape_params(text: &str, file: &str) -> (acr_parser::ParamList, acr_parser::Loc) {
+        let full = format!("WorldBegin {text} WorldEnd");
+        let d = acr_parser::parse_str(&full, std::path::Path::new(file)).unwrap();
+        let s = &d.shapes[0];
+        (s.plugin.params.clone(), s.plugin.loc.clone())
+    }
 }
 
 #[cfg(test)]

@@ -340,13 +340,9 @@ fn direction(params: &ParamList, loc: &Loc, dir: char) -> Result<(Direction, f32
 #[cfg(test)]
 mod tests {
     use super::*;
-    use acr_parser::parse_str;
-    use std::path::Path;
 
     fn shape_params(text: &str) -> (ParamList, Loc) {
-        let d = parse_str(&format!("WorldBegin {text} WorldEnd"), Path::new("n.pbrt")).unwrap();
-        let s = &d.shapes[0];
-        (s.plugin.params.clone(), s.plugin.loc.clone())
+        super::super::test_util::shape_params(text, "n.pbrt")
     }
 
     fn list(v: &[f32]) -> String {

@@ -260,15 +260,6 @@ mod tests {
         ]
     }
 
-    #[track_caller]
-    fn close_rel(a: Vec3, b: Vec3, eps: f32, what: &str, line: &str) {
-        let scale = 1.0 + b.abs().max_element();
-        assert!(
-            (a - b).abs().max_element() <= eps * scale,
-            "{what}: {a} != pbrt-v3's {b}\n{line}"
-        );
-    }
-
     /// Rays against pbrt-v3's own cone, paraboloid and hyperboloid (transformed, one reversed,
     /// one mirrored): the same hits and misses, t, point, normal, uv, dp/du, dp/dv, dn/du and
     /// dn/dv; the areas as pbrt-v3's `Area()`.
