@@ -150,6 +150,27 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
 }
 
 impl SurfaceInteraction {
+    /// For tests: a point `p` with coordinates `uv` on the plane z = const facing +z, its
+    /// tangents x and y, seen from +z.
+    #[cfg(test)]
+    pub(crate) fn flat(p: Vec3, uv: Vec2) -> Self {
+        Self {
+            p,
+            n: Vec3::Z,
+            uv,
+            dpdu: Vec3::X,
+            dpdv: Vec3::Y,
+            shading_n: Vec3::Z,
+            shading_dpdu: Vec3::X,
+            shading_dpdv: Vec3::Y,
+            dndu: Vec3::ZERO,
+            dndv: Vec3::ZERO,
+            wo: Vec3::Z,
+            time: 0.0,
+            p_error: 0.0,
+        }
+    }
+
     /// The geometric normal flipped to the side of `w`.
     #[inline]
     pub fn n_towards(&self, w: Vec3) -> Vec3 {

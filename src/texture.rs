@@ -1126,21 +1126,7 @@ mod tests {
     use acr_parser::parse_str;
 
     fn si_uv(u: f32, v: f32) -> SurfaceInteraction {
-        SurfaceInteraction {
-            p: Vec3::new(u, v, 0.0),
-            n: Vec3::Z,
-            uv: Vec2::new(u, v),
-            dpdu: Vec3::X,
-            dpdv: Vec3::Y,
-            shading_n: Vec3::Z,
-            shading_dpdu: Vec3::X,
-            shading_dpdv: Vec3::Y,
-            dndu: Vec3::ZERO,
-            dndv: Vec3::ZERO,
-            wo: Vec3::Z,
-            time: 0.0,
-            p_error: 0.0,
-        }
+        SurfaceInteraction::flat(Vec3::new(u, v, 0.0), Vec2::new(u, v))
     }
 
     fn si_p(p: Vec3) -> SurfaceInteraction {

@@ -22,21 +22,7 @@ fn material(params: &str) -> Material {
 
 /// A hit whose shading frame is the local frame (normal z, tangent x).
 fn flat_hit() -> SurfaceInteraction {
-    SurfaceInteraction {
-        p: Vec3::ZERO,
-        n: Vec3::Z,
-        uv: Vec2::new(0.3, 0.6),
-        dpdu: Vec3::X,
-        dpdv: Vec3::Y,
-        shading_n: Vec3::Z,
-        shading_dpdu: Vec3::X,
-        shading_dpdv: Vec3::Y,
-        dndu: Vec3::ZERO,
-        dndv: Vec3::ZERO,
-        wo: Vec3::Z,
-        time: 0.0,
-        p_error: 0.0,
-    }
+    SurfaceInteraction::flat(Vec3::ZERO, Vec2::new(0.3, 0.6))
 }
 
 fn close(got: f32, want: f32, rel: f32) -> bool {

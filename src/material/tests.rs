@@ -6,21 +6,7 @@ use crate::geometry::{Vec2, Vec3};
 use acr_parser::parse_str;
 
 fn si() -> SurfaceInteraction {
-    SurfaceInteraction {
-        p: Vec3::new(0.1, 0.2, 0.0),
-        n: Vec3::Z,
-        uv: Vec2::new(0.3, 0.6),
-        dpdu: Vec3::X,
-        dpdv: Vec3::Y,
-        shading_n: Vec3::Z,
-        shading_dpdu: Vec3::X,
-        shading_dpdv: Vec3::Y,
-        dndu: Vec3::ZERO,
-        dndv: Vec3::ZERO,
-        wo: Vec3::Z,
-        time: 0.0,
-        p_error: 0.0,
-    }
+    SurfaceInteraction::flat(Vec3::new(0.1, 0.2, 0.0), Vec2::new(0.3, 0.6))
 }
 
 /// Parses world-block text and builds its materials, every one used by a shape.
