@@ -252,13 +252,10 @@ fn parse_pfm(data: &[u8]) -> Result<RgbImage, String> {
     Ok(img)
 }
 
-/// Writes an image, choosing the format by extension: `.exr` (linear 32-bit float RGB), `.png`
-/// (8-bit sRGB: clamped to [0, 1], encoded, rounded, as pbrt-v3 writes it) or `.pfm` (linear
-/// 32-bit float RGB, little-endian).
 /// Where an image lies in a larger frame: a crop of a `width` x `height` image whose top-left
 /// pixel is (`x0`, `y0`). An EXR carries it as its display window (the frame) and data window
 /// (the crop), as OpenEXR and pbrt-v4 do, so that an assembler can place the crop.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Frame {
     /// The whole image's width.
     pub width: usize,
@@ -317,6 +314,9 @@ pub fn read_image_with_frame(path: &Path) -> Result<(RgbImage, Frame), String> {
     Ok((img, frame))
 }
 
+/// Writes an image, choosing the format by extension: `.exr` (linear 32-bit float RGB), `.png`
+/// (8-bit sRGB: clamped to [0, 1], encoded, rounded, as pbrt-v3 writes it) or `.pfm` (linear
+/// 32-bit float RGB, little-endian).
 pub fn write_image(path: &Path, img: &RgbImage) -> Result<(), String> {
     if img.pixels.len() != img.width * img.height {
         return Err(format!(

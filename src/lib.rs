@@ -8,6 +8,7 @@ pub mod bump;
 pub mod camera;
 pub mod cli;
 pub mod disney;
+pub mod exr_channels;
 pub mod features;
 pub use acr_plugins::film;
 pub mod geometry;

@@ -63,12 +63,17 @@ pub fn in_pixel(px: u32, py: u32, u: Vec2) -> Vec2 {
     p.min(Vec2::new(below(px + 1), below(py + 1)))
 }
 
-/// A write of the image so far, every `every` of render time (`--write-partial-images`).
+/// A look at the image so far, every `every` of render time (`--write-partial-images`, the
+/// display).
 pub struct Checkpoint<'a> {
     /// How often.
     pub every: Duration,
-    /// Writes the film's image.
-    pub write: &'a (dyn Fn(&Film) + Sync),
+    /// Waits, once due, for the film to hold whole passes (every pixel as many samples as the
+    /// others, so that a partial image is a sample range that resumes exactly), when the
+    /// sampler's batches come in passes ([`Sampler::whole_passes`]; an adaptive one's do not).
+    pub whole_passes: bool,
+    /// Takes the film, with the render seconds so far.
+    pub look: &'a (dyn Fn(&Film, f64) + Sync),
 }
 
 /// When a render stops before its sampler's budget is spent.
@@ -77,8 +82,8 @@ pub struct Stop<'a> {
     /// Stop (at the end of the pass under way) once this is set: the signal handler of
     /// SIGINT and SIGTERM sets it.
     pub interrupt: Option<&'a std::sync::atomic::AtomicBool>,
-    /// Write the image so far now and then.
-    pub checkpoint: Option<Checkpoint<'a>>,
+    /// Look at the image so far now and then.
+    pub checkpoints: Vec<Checkpoint<'a>>,
     /// Stop once this much render time has passed (at the end of the pass under way).
     pub time_limit: Option<Duration>,
     /// Stop once the image's estimated relative error ([`relative_error`]) is below this (at
@@ -342,7 +347,9 @@ pub fn render_with(
     // from `min_spp` on.
     let pixels = space.pixels().max(1);
     let mut next_check = pixels * u64::from(stop.min_spp.max(2));
-    let mut last_checkpoint = Instant::now();
+    let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
+    let last_pixel = space.pixel(space.pixels().saturating_sub(1));
+    let in_passes = sampler.whole_passes();
     let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
     while more {
         // While `batch` is traced, the sampler and the film take the batch before and, when
@@ -363,11 +370,13 @@ pub fn render_with(
         if let Some(p) = progress {
             p.set_position(counts.samples);
         }
-        if let Some(c) = &stop.checkpoint {
-            if last_checkpoint.elapsed() >= c.every {
-                // The film holds what the sampler has handed over so far.
-                (c.write)(film);
-                last_checkpoint = Instant::now();
+        // The film holds what the sampler has handed over so far, `batch` the last of it: a
+        // batch ending at the last pixel ends a pass.
+        let pass_done = !in_passes || batch.last().is_some_and(|q| q.pixel == last_pixel);
+        for (c, last) in stop.checkpoints.iter().zip(&mut last_look) {
+            if last.elapsed() >= c.every && (!c.whole_passes || pass_done) {
+                (c.look)(film, start.elapsed().as_secs_f64());
+                *last = Instant::now();
             }
         }
         if counts.halted_by.is_none() {

@@ -185,6 +185,22 @@ fn cropwindow_places_the_crop_and_bad_crops_fail_cleanly() {
         "120,200,0,160",
     ]);
     fails(&["merge", s(&m), s(&a), s(&d)], "frame");
+    // A crop of another scene of the same size: told apart by the scene's hash.
+    let lit = dir.join("lit.pbrt");
+    let text = std::fs::read_to_string(&scene).unwrap() + "\n# another scene\n";
+    std::fs::write(&lit, text).unwrap();
+    let e = dir.join("e.exr");
+    let mut args = vec!["render", s(&lit), "-o", s(&e), "--spp", "1", "-q"];
+    args.extend(["--pixelbounds", "120,240,0,160"]);
+    ok(&args);
+    fails(&["merge", s(&m), s(&a), s(&e)], "another scene");
+    // A file cut short (a crop being written when its node died) is refused.
+    let cut = dir.join("cut.exr");
+    let bytes = std::fs::read(&c).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let a2 = part("a2.exr", "0,120,100,160");
+    fails(&["merge", s(&m), s(&a), s(&cut), s(&a2)], "cut.exr");
+    assert!(!m.exists(), "no image written from bad input");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -329,11 +345,30 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
                 worst < 1e-5,
                 "{sampler} + {filter}: relative difference {worst}"
             );
+            // The variance moments add up too: the merge's per-pixel sample variance is the
+            // whole render's.
+            let (mv, wv) = (merged.variance().unwrap(), whole.variance().unwrap());
+            let worst_var = mv
+                .iter()
+                .zip(&wv)
+                .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / y[c].abs().max(1e-3)))
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst_var < 1e-4,
+                "{sampler} + {filter}: variance {worst_var}"
+            );
             // The plain image of the merge reads back as the mean.
             let (img, _) = read_image_with_frame(&m).unwrap();
             assert_eq!(img.pixels.len(), merged.sums.len());
         }
     }
+    // Ranges that overlap would count samples twice: refused, naming both.
+    let (full, b) = (dir.join("full.exr"), dir.join("b.exr"));
+    fails(
+        &["merge", s(&dir.join("bad.exr")), s(&full), s(&b)],
+        "must not overlap",
+    );
+    assert!(!dir.join("bad.exr").exists());
     let o = dir.join("x.exr");
     let png = dir.join("x.png");
     fails(
@@ -378,5 +413,85 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
         ],
         "splatting filter",
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A render stopped by SIGTERM leaves a mergeable EXR of whole passes (its partial writes too:
+/// every pixel as many samples as the header says), and rendering the missing range and
+/// merging gives the render that was never stopped.
+#[test]
+fn a_stopped_render_resumes_by_rendering_the_rest_and_merging() {
+    use acr::cli::mergeable::Sums;
+    let dir = temp_dir("resume");
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.pbrt");
+    let sc = s(&scene);
+    let (part, rest, merged, full) = (
+        dir.join("part.exr"),
+        dir.join("rest.exr"),
+        dir.join("merged.exr"),
+        dir.join("full.exr"),
+    );
+    const SPP: u32 = 64;
+    let spp = SPP.to_string();
+    let common = ["--sampler", "random", "--quiet"];
+    let child = Command::new(env!("CARGO_BIN_EXE_acr"))
+        .args(["render", sc, "-o", s(&part), "--spp", &spp])
+        .args(common)
+        .args(["--threads", "1", "--write-partial-images", "0.05"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !part.exists() {
+        assert!(start.elapsed().as_secs() < 120, "no partial image");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // A partial write holds whole passes.
+    let early = Sums::read(&part)
+        .unwrap()
+        .expect("a mergeable partial image");
+    assert!(early.spp >= 1 && early.spp < SPP, "{}", early.spp);
+    assert!(early.counts.iter().all(|&c| c == f64::from(early.spp)));
+    // SAFETY: kill(2) on our own child's pid, with a valid signal number.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) },
+        0
+    );
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{err}");
+    let stopped = Sums::read(&part)
+        .unwrap()
+        .expect("a mergeable image at the stop");
+    let k = stopped.spp;
+    assert!(k >= early.spp && k < SPP, "{k}");
+    assert_eq!(stopped.offset, Some(0));
+    assert!(stopped.counts.iter().all(|&c| c == f64::from(k)));
+    assert!(
+        err.contains(&format!("--sample-offset {k} --spp {}", SPP - k)),
+        "{err}"
+    );
+    let (k_s, left) = (k.to_string(), (SPP - k).to_string());
+    let mut args = vec!["render", sc, "-o", s(&rest), "--spp", &left];
+    args.extend(["--sample-offset", &k_s, "--mergeable"]);
+    args.extend(common);
+    ok(&args);
+    ok(&["merge", s(&merged), s(&part), s(&rest)]);
+    let mut args = vec!["render", sc, "-o", s(&full), "--spp", &spp, "--mergeable"];
+    args.extend(common);
+    ok(&args);
+    let (m, f) = (
+        Sums::read(&merged).unwrap().unwrap(),
+        Sums::read(&full).unwrap().unwrap(),
+    );
+    assert_eq!((m.spp, m.offset), (SPP, Some(0)));
+    let worst = m
+        .image()
+        .iter()
+        .zip(f.image())
+        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / y[c].abs().max(1e-3)))
+        .fold(0.0f32, f32::max);
+    eprintln!("stopped at {k} of {SPP} spp; resumed: largest relative difference {worst:.1e}");
+    assert!(worst < 1e-5, "{worst}");
     let _ = std::fs::remove_dir_all(&dir);
 }

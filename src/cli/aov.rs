@@ -52,13 +52,13 @@ impl AovRequest {
     }
 }
 
-/// Parses `NAME=FILE[,NAME=FILE...]` as `--aov` takes it.
+/// Parses `NAME[=FILE][,NAME[=FILE]...]` as `--aov` takes it; a NAME without a file (an
+/// empty path) goes into the output EXR as channels.
 pub fn parse_aovs(arg: &str) -> Result<Vec<AovRequest>, String> {
     arg.split(',')
         .map(|part| {
-            let (name, file) = part
-                .split_once('=')
-                .ok_or_else(|| format!("--aov \"{part}\" is not NAME=FILE (e.g. spp=spp.png)"))?;
+            // A NAME alone is a channel of the output EXR.
+            let (name, file) = part.split_once('=').unwrap_or((part, ""));
             let name = name.trim();
             if !AOV_NAMES.contains(&name) {
                 let hint = acr_parser::closest(name, AOV_NAMES.iter().copied())
@@ -68,14 +68,17 @@ pub fn parse_aovs(arg: &str) -> Result<Vec<AovRequest>, String> {
                     AOV_NAMES.join(", ")
                 ));
             }
-            if file.is_empty() {
+            if file.is_empty() && part.contains('=') {
                 return Err(format!("--aov {name}: the file name is empty"));
             }
             let req = AovRequest {
                 name: name.to_owned(),
                 path: PathBuf::from(file),
             };
-            if req.is_feature() && !matches!(req.extension().as_str(), "exr" | "pfm") {
+            if req.is_feature()
+                && !file.is_empty()
+                && !matches!(req.extension().as_str(), "exr" | "pfm")
+            {
                 return Err(format!(
                     "--aov {name}: \"{file}\" must be an .exr or .pfm (linear values, as \
                      denoisers read them)"
@@ -301,8 +304,11 @@ mod tests {
         assert_eq!(r[1].path, PathBuf::from("b.exr"));
         let e = parse_aovs("sp=a.png").unwrap_err();
         assert!(e.contains("did you mean \"spp\""), "{e}");
-        assert!(parse_aovs("spp").is_err());
+        // A name alone is a channel of the output: an empty path.
+        let r = parse_aovs("spp,albedo").unwrap();
+        assert!(r.iter().all(|a| a.path.as_os_str().is_empty()));
         assert!(parse_aovs("spp=").is_err());
+        assert!(parse_aovs("albedo=a.png").is_err());
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! `imgtool assemble` does (every pixel of the frame from exactly one input).
 
 use super::mergeable::Sums;
+use crate::exr_channels::read_attribute;
 use crate::geometry::Spectrum;
 use crate::image_io::{read_image_with_frame, write_image, Frame, RgbImage};
 use std::path::{Path, PathBuf};
@@ -34,6 +35,30 @@ pub fn command(output: &Path, inputs: &[PathBuf]) -> Result<(), String> {
             .iter()
             .all(|(_, s)| s.as_ref().is_some_and(same_crop))
         {
+            let mut known: Vec<(std::ops::Range<u64>, &PathBuf)> = ranges
+                .iter()
+                .filter_map(|(p, s)| Some((s.as_ref()?.range()?, *p)))
+                .collect();
+            if let Some(r) = total.range() {
+                known.push((r, &inputs[0]));
+            }
+            known.sort_by_key(|(r, _)| (r.start, r.end));
+            for pair in known.windows(2) {
+                let ((a, pa), (b, pb)) = (&pair[0], &pair[1]);
+                if b.start < a.end {
+                    return Err(format!(
+                        "{} holds samples {}..{} and {} samples {}..{}: sample ranges must not \
+                         overlap (render the next range with --sample-offset {})",
+                        pa.display(),
+                        a.start,
+                        a.end,
+                        pb.display(),
+                        b.start,
+                        b.end,
+                        a.end
+                    ));
+                }
+            }
             for (p, s) in &ranges {
                 if let Some(s) = s {
                     total.add(s).map_err(|e| format!("{}: {e}", p.display()))?;
@@ -79,6 +104,18 @@ pub fn command(output: &Path, inputs: &[PathBuf]) -> Result<(), String> {
                 owner[i] = k as u32 + 1;
                 image.pixels[i] = crop.pixels[y * crop.width + x];
             }
+        }
+    }
+    let mut scenes = inputs
+        .iter()
+        .filter_map(|p| Some((p, read_attribute(p, "sceneHash")?)));
+    if let Some((first, hash)) = scenes.next() {
+        if let Some((other, _)) = scenes.find(|(_, h)| *h != hash) {
+            return Err(format!(
+                "{} was rendered from another scene than {} (their sceneHash attributes differ)",
+                other.display(),
+                first.display()
+            ));
         }
     }
     if let Some(i) = owner.iter().position(|&o| o == 0) {

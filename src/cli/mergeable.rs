@@ -1,15 +1,18 @@
 //! Mergeable EXRs: beside the image (R, G, B), each pixel's filter-weighted radiance sums
-//! (`sum.R`, `sum.G`, `sum.B`, times the film's scale), its filter-weight sum (`weight`) and its
-//! sample count (`count`), with pbrt-v4's header attributes `samplesPerPixel` and
-//! `renderTimeSeconds`. Renders of different sample ranges of one frame add their sums and
-//! weights: the merge is the image of all their samples (Cycles' `merge_images`, weighted).
+//! (`sum.R`, `sum.G`, `sum.B`, times the film's scale), its filter-weight sum (`weight`), its
+//! sample count (`count`) and the variance moments of its samples (`moment1.*`, the sum of
+//! their radiance, and `moment2.*`, of its square, unweighted and unscaled), with pbrt-v4's
+//! header attributes `samplesPerPixel` and `renderTimeSeconds` and acr's `sampleOffset`.
+//! Renders of different sample ranges of one frame add their sums, weights and moments: the
+//! merge is the image of all their samples (Cycles' `merge_images`, weighted). `Variance.*`
+//! (pbrt-v4's name and meaning: the variance of a pixel's samples) is written from the moments.
 
+use crate::exr_channels::{Attribute, Channels};
 use crate::image_io::Frame;
-use exr::prelude::*;
 use std::path::Path;
 
 /// What a mergeable EXR holds, for one crop of a frame.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Sums {
     /// Where the crop lies.
     pub frame: Frame,
@@ -21,11 +24,43 @@ pub struct Sums {
     pub sums: Vec<[f64; 4]>,
     /// Per pixel: samples drawn in it.
     pub counts: Vec<f64>,
+    /// Per pixel: the sum of its samples' radiance and of its square, per channel (absent in
+    /// files written before they were).
+    pub moments: Option<Vec<[f64; 6]>>,
+    /// AOV channels (first-hit features, cluster ids...), each a per-pixel mean over the
+    /// pixel's samples: sample ranges merge them weighted by their counts.
+    pub aovs: Vec<(String, Vec<f32>)>,
     /// Samples per pixel of the render(s).
     pub spp: u32,
+    /// The first sample index, when known.
+    pub offset: Option<u32>,
+    /// A hash of the scene's text (`sceneHash`), when known: renders of other scenes do not
+    /// merge.
+    pub scene: Option<i32>,
     /// Render seconds, summed over merged renders.
     pub seconds: f64,
 }
+
+/// The channels [`Sums`] reads and writes itself; any other is an AOV.
+const OWN_CHANNELS: &[&str] = &[
+    "R",
+    "G",
+    "B",
+    "sum.R",
+    "sum.G",
+    "sum.B",
+    "weight",
+    "count",
+    "moment1.R",
+    "moment1.G",
+    "moment1.B",
+    "moment2.R",
+    "moment2.G",
+    "moment2.B",
+    "Variance.R",
+    "Variance.G",
+    "Variance.B",
+];
 
 impl Sums {
     /// The image: each pixel's weighted mean (0 where no weight, and never negative, as the
@@ -43,10 +78,52 @@ impl Sums {
             .collect()
     }
 
-    /// Adds `other`'s samples (another sample range of the same crop).
+    /// Each pixel's sample variance per channel (pbrt-v4's `Variance`), 0 below two samples.
+    pub fn variance(&self) -> Option<Vec<[f32; 3]>> {
+        let moments = self.moments.as_ref()?;
+        Some(
+            moments
+                .iter()
+                .zip(&self.counts)
+                .map(|(m, &n)| {
+                    if n < 2.0 {
+                        return [0.0; 3];
+                    }
+                    [0, 1, 2].map(|c| ((m[3 + c] - m[c] * m[c] / n) / (n - 1.0)).max(0.0) as f32)
+                })
+                .collect(),
+        )
+    }
+
+    /// The sample indices it holds, when known: [offset, offset + spp).
+    pub fn range(&self) -> Option<std::ops::Range<u64>> {
+        self.offset
+            .map(|o| u64::from(o)..u64::from(o) + u64::from(self.spp))
+    }
+
+    /// Adds `other`'s samples (another sample range of the same crop). AOV channels both hold
+    /// become their count-weighted mean; the others are dropped.
     pub fn add(&mut self, other: &Sums) -> std::result::Result<(), String> {
         if (self.frame, self.width, self.height) != (other.frame, other.width, other.height) {
             return Err("not the same crop of the same frame".to_owned());
+        }
+        if let (Some(a), Some(b)) = (self.scene, other.scene) {
+            if a != b {
+                return Err("rendered from another scene (its sceneHash differs)".to_owned());
+            }
+        }
+        self.aovs
+            .retain(|(name, _)| other.aovs.iter().any(|(n, _)| n == name));
+        for (name, values) in &mut self.aovs {
+            let Some((_, theirs)) = other.aovs.iter().find(|(n, _)| n == name) else {
+                continue;
+            };
+            for (i, v) in values.iter_mut().enumerate() {
+                let (a, b) = (self.counts[i], other.counts[i]);
+                if a + b > 0.0 {
+                    *v = ((f64::from(*v) * a + f64::from(theirs[i]) * b) / (a + b)) as f32;
+                }
+            }
         }
         for (a, b) in self.sums.iter_mut().zip(&other.sums) {
             for c in 0..4 {
@@ -56,75 +133,82 @@ impl Sums {
         for (a, b) in self.counts.iter_mut().zip(&other.counts) {
             *a += b;
         }
+        self.moments = match (self.moments.take(), &other.moments) {
+            (Some(mut m), Some(o)) => {
+                for (a, b) in m.iter_mut().zip(o) {
+                    for c in 0..6 {
+                        a[c] += b[c];
+                    }
+                }
+                Some(m)
+            }
+            _ => None,
+        };
+        self.offset = match (self.range(), other.range()) {
+            (Some(a), Some(b)) => Some(a.start.min(b.start) as u32),
+            _ => None,
+        };
         self.spp += other.spp;
         self.seconds += other.seconds;
         Ok(())
     }
 
-    /// Writes the EXR: R, G, B, the sums, weight and count, and the attributes.
+    /// Writes the EXR: R, G, B, the sums, weight, count, moments and variance, the AOVs, and
+    /// the attributes.
     pub fn write(&self, path: &Path) -> std::result::Result<(), String> {
         let n = self.width * self.height;
         let image = self.image();
-        let channel =
-            |name: &str, values: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(values));
+        let mut layer = Channels::new(self.frame, self.width, self.height);
         let pick = |f: &dyn Fn(usize) -> f32| (0..n).map(f).collect::<Vec<f32>>();
-        let channels = AnyChannels::sort(SmallVec::from_vec(vec![
-            channel("R", pick(&|i| image[i][0])),
-            channel("G", pick(&|i| image[i][1])),
-            channel("B", pick(&|i| image[i][2])),
-            channel("sum.R", pick(&|i| self.sums[i][0] as f32)),
-            channel("sum.G", pick(&|i| self.sums[i][1] as f32)),
-            channel("sum.B", pick(&|i| self.sums[i][2] as f32)),
-            channel("weight", pick(&|i| self.sums[i][3] as f32)),
-            channel("count", pick(&|i| self.counts[i] as f32)),
-        ]));
-        let mut attributes = LayerAttributes {
-            layer_position: Vec2(self.frame.x0 as i32, self.frame.y0 as i32),
-            ..LayerAttributes::default()
-        };
-        attributes.other.insert(
-            Text::from("samplesPerPixel"),
-            AttributeValue::I32(self.spp.min(i32::MAX as u32) as i32),
-        );
-        attributes.other.insert(
-            Text::from("renderTimeSeconds"),
-            AttributeValue::F32(self.seconds as f32),
-        );
-        let encoding = Encoding {
-            line_order: LineOrder::Increasing,
-            ..Encoding::FAST_LOSSLESS
-        };
-        let layer = Layer::new((self.width, self.height), attributes, encoding, channels);
-        let display = IntegerBounds::new((0, 0), (self.frame.width, self.frame.height));
-        Image::new(ImageAttributes::new(display), layer)
-            .write()
-            .to_file(path)
-            .map_err(|e| e.to_string())
+        for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+            layer.push(name, pick(&|i| image[i][c]));
+        }
+        for (c, name) in ["sum.R", "sum.G", "sum.B", "weight"]
+            .into_iter()
+            .enumerate()
+        {
+            layer.push(name, pick(&|i| self.sums[i][c] as f32));
+        }
+        layer.push("count", pick(&|i| self.counts[i] as f32));
+        if let (Some(m), Some(var)) = (&self.moments, self.variance()) {
+            for (c, rgb) in ["R", "G", "B"].into_iter().enumerate() {
+                layer.push(&format!("moment1.{rgb}"), pick(&|i| m[i][c] as f32));
+                layer.push(&format!("moment2.{rgb}"), pick(&|i| m[i][3 + c] as f32));
+                layer.push(&format!("Variance.{rgb}"), pick(&|i| var[i][c]));
+            }
+        }
+        for (name, values) in &self.aovs {
+            layer.push(name, values.clone());
+        }
+        let spp = self.spp.min(i32::MAX as u32) as i32;
+        layer
+            .attributes
+            .push(("samplesPerPixel".into(), Attribute::Int(spp)));
+        layer.attributes.push((
+            "renderTimeSeconds".into(),
+            Attribute::Float(self.seconds as f32),
+        ));
+        if let Some(h) = self.scene {
+            layer
+                .attributes
+                .push(("sceneHash".into(), Attribute::Int(h)));
+        }
+        if let Some(o) = self.offset {
+            let o = o.min(i32::MAX as u32) as i32;
+            layer
+                .attributes
+                .push(("sampleOffset".into(), Attribute::Int(o)));
+        }
+        layer.write(path)
     }
 
     /// Reads a mergeable EXR; `None` when the file lacks the sums (a plain image).
     pub fn read(path: &Path) -> std::result::Result<Option<Sums>, String> {
-        let image = read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .all_channels()
-            .first_valid_layer()
-            .all_attributes()
-            .from_file(path)
-            .map_err(|e| e.to_string())?;
-        let layer = &image.layer_data;
+        let layer = Channels::read(path)?;
         let find = |name: &str| {
             layer
-                .channel_data
-                .list
-                .iter()
-                .find(|c| c.name.to_string() == name)
-                .map(|c| {
-                    c.sample_data
-                        .values_as_f32()
-                        .map(f64::from)
-                        .collect::<Vec<f64>>()
-                })
+                .get(name)
+                .map(|v| v.iter().copied().map(f64::from).collect::<Vec<f64>>())
         };
         let (Some(r), Some(g), Some(b), Some(w), Some(count)) = (
             find("sum.R"),
@@ -135,40 +219,44 @@ impl Sums {
         ) else {
             return Ok(None);
         };
-        let display = image.attributes.display_window;
-        let pos = layer.attributes.layer_position;
-        let (dx, dy) = (
-            pos.x() - display.position.x(),
-            pos.y() - display.position.y(),
-        );
-        let (width, height) = (layer.size.width(), layer.size.height());
-        if dx < 0
-            || dy < 0
-            || dx as usize + width > display.size.width()
-            || dy as usize + height > display.size.height()
-        {
-            return Err("its data window is not within its display window".to_owned());
-        }
-        let spp = match layer.attributes.other.get(&Text::from("samplesPerPixel")) {
-            Some(AttributeValue::I32(v)) => (*v).max(0) as u32,
-            _ => 0,
+        let moment_channels = ["moment1.R", "moment1.G", "moment1.B"]
+            .into_iter()
+            .chain(["moment2.R", "moment2.G", "moment2.B"])
+            .map(find)
+            .collect::<Option<Vec<Vec<f64>>>>();
+        let moments = moment_channels.map(|m| {
+            (0..r.len())
+                .map(|i| std::array::from_fn(|c| m[c][i]))
+                .collect()
+        });
+        let int = |name: &str| match layer.attribute(name) {
+            Some(Attribute::Int(v)) => Some(v.max(0) as u32),
+            _ => None,
         };
-        let seconds = match layer.attributes.other.get(&Text::from("renderTimeSeconds")) {
-            Some(AttributeValue::F32(v)) => f64::from(*v),
+        let seconds = match layer.attribute("renderTimeSeconds") {
+            Some(Attribute::Float(v)) => f64::from(v),
             _ => 0.0,
         };
+        let aovs = layer
+            .channels
+            .iter()
+            .filter(|(name, _)| !OWN_CHANNELS.contains(&name.as_str()))
+            .cloned()
+            .collect();
         Ok(Some(Sums {
-            frame: Frame {
-                width: display.size.width(),
-                height: display.size.height(),
-                x0: dx as usize,
-                y0: dy as usize,
-            },
-            width,
-            height,
+            frame: layer.frame,
+            width: layer.width,
+            height: layer.height,
             sums: (0..r.len()).map(|i| [r[i], g[i], b[i], w[i]]).collect(),
             counts: count,
-            spp,
+            moments,
+            aovs,
+            spp: int("samplesPerPixel").unwrap_or(0),
+            offset: int("sampleOffset"),
+            scene: match layer.attribute("sceneHash") {
+                Some(Attribute::Int(h)) => Some(h),
+                _ => None,
+            },
             seconds,
         }))
     }

@@ -2,11 +2,12 @@
 
 use super::{parse_seconds, parse_threshold};
 use crate::cli::aov::{parse_aovs, write_aov, AovRequest};
-use crate::cli::mergeable::Sums;
+use crate::cli::display::Display;
+use crate::cli::output::{reached_spp, End, Output};
 use crate::cli::replay::{Recording, Replay};
 use crate::cli::stats::{median, peak_rss_mb, Seconds, Stats};
 use crate::features::FeatureImage;
-use crate::image_io::{write_image_in_frame, Frame, RgbImage};
+use crate::image_io::Frame;
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};
 use crate::render::{render, render_with_features, Checkpoint, Halt, Stop, MAX_SPP};
@@ -58,9 +59,12 @@ pub struct RenderArgs {
     #[arg(long = "set", value_name = "KIND.PARAM=VALUE")]
     pub set: Vec<String>,
     /// Extra per-pixel outputs, NAME=FILE[,NAME=FILE]: spp (samples per pixel), variance (of
-    /// each pixel's mean), clusters (cluster sampler), fitclusters (the clusters the polynomial filter fitted), albedo, normal, depth (means of the
-    /// first-hit features, .exr or .pfm). An .exr holds the values; a .png is false colour
-    /// scaled by the largest value (the scale is printed and stored in the PNG). Repeatable.
+    /// each pixel's mean), clusters (cluster sampler), fitclusters (the clusters the
+    /// polynomial filter fitted), albedo, normal, depth (means of the first-hit features, .exr
+    /// or .pfm). An .exr holds the values; a .png is false colour scaled by the largest value
+    /// (the scale is printed and stored in the PNG). A NAME without a file (albedo, normal,
+    /// depth, spp, variance) goes into the output EXR as channels, with pbrt-v4's GBuffer
+    /// names (Albedo.R, Ns.X, Z, count, Variance.R...). Repeatable.
     #[arg(long, value_name = "NAME=FILE")]
     pub aov: Vec<String>,
     /// Worker threads (default: every core).
@@ -111,6 +115,11 @@ pub struct RenderArgs {
     /// Film's cropwindow).
     #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_bounds)]
     pub pixelbounds: Option<[u32; 4]>,
+    /// Show the image as it renders in the tev viewer listening at HOST:PORT (pbrt-v4's
+    /// --display-server; tev listens on 127.0.0.1:14158 by default): every second, and the
+    /// final image at the end.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub display_server: Option<String>,
 }
 
 /// Four comma-separated numbers.
@@ -348,7 +357,49 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         .into_iter()
         .flatten()
         .collect();
+    let frame = Frame {
+        width: scene.film.resolution.0 as usize,
+        height: scene.film.resolution.1 as usize,
+        x0: scene.film.crop[0] as usize,
+        y0: scene.film.crop[2] as usize,
+    };
+    let (w, h) = scene.film.size();
+    let is_exr = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let mut out = Output {
+        path: output.clone(),
+        frame,
+        size: (w as usize, h as usize),
+        scale: scene.film.scale,
+        mergeable: args.mergeable,
+        can_merge: is_exr && splats && plugins.sampler.streams() == 1,
+        offset: args.sample_offset,
+        channel_aovs: Vec::new(),
+        scene: crate::cli::output::scene_hash(&desc),
+    };
     for a in &aovs {
+        if out.holds(a) {
+            if !is_exr {
+                return Err(format!(
+                    "--aov {}: AOVs go into the output as channels only when it is an .exr, not \
+                     {}",
+                    a.name,
+                    output.display()
+                ));
+            }
+            if !crate::cli::output::CHANNEL_AOVS
+                .iter()
+                .any(|(n, _)| *n == a.name)
+            {
+                return Err(format!(
+                    "--aov {}: cannot be a channel of the output (give it a file of its own)",
+                    a.name
+                ));
+            }
+            out.channel_aovs.push(a.name.clone());
+            continue;
+        }
         check_writable(&a.path)?;
         if a.name == "clusters" && plugins.sampler.report().cells.is_none() {
             return Err(format!(
@@ -386,33 +437,50 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             .and_then(|_| signal_hook::flag::register(signal, Arc::clone(&interrupted)))
             .map_err(|e| format!("cannot watch for signals: {e}"))?;
     }
-    let frame = Frame {
-        width: scene.film.resolution.0 as usize,
-        height: scene.film.resolution.1 as usize,
-        x0: scene.film.crop[0] as usize,
-        y0: scene.film.crop[2] as usize,
-    };
-    let (w, h) = scene.film.size();
-    let write_partial = |film: &Film| {
-        let scale = film.settings().scale;
-        let image = RgbImage {
-            width: w as usize,
-            height: h as usize,
-            pixels: film.pixels().into_iter().map(|c| c * scale).collect(),
-        };
-        if let Err(e) = write_atomically(&output, &image, frame) {
+    let write_partial = |film: &Film, seconds: f64| {
+        if let Err(e) = out.write_partial(film, seconds) {
             eprintln!("warning: partial image: {e}");
         }
     };
+    let display = args.display_server.as_deref().and_then(|address| {
+        let name = output
+            .file_name()
+            .map_or_else(|| "acr".to_owned(), |n| n.to_string_lossy().into_owned());
+        Display::connect(address, &name, w as usize, h as usize)
+    });
+    let show = |film: &Film, _: f64| {
+        if let Some(d) = &display {
+            let scale = film.settings().scale;
+            d.show(
+                &film
+                    .pixels()
+                    .into_iter()
+                    .map(|c| c * scale)
+                    .collect::<Vec<_>>(),
+            );
+        }
+    };
+    let mut checkpoints = Vec::new();
+    if let Some(s) = args.write_partial_images {
+        checkpoints.push(Checkpoint {
+            every: std::time::Duration::from_secs_f64(s),
+            whole_passes: true,
+            look: &write_partial,
+        });
+    }
+    if display.is_some() {
+        checkpoints.push(Checkpoint {
+            every: std::time::Duration::from_secs(1),
+            whole_passes: false,
+            look: &show,
+        });
+    }
     let stop = Stop {
         time_limit: args.time_limit.map(std::time::Duration::from_secs_f64),
         noise_threshold: args.noise_threshold,
         min_spp: args.min_spp,
         interrupt: Some(&interrupted),
-        checkpoint: args.write_partial_images.map(|s| Checkpoint {
-            every: std::time::Duration::from_secs_f64(s),
-            write: &write_partial,
-        }),
+        checkpoints,
     };
     let mut features = aovs.iter().any(AovRequest::is_feature).then(|| {
         let [x0, x1, y0, y1] = scene.film.crop;
@@ -461,41 +529,22 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     // The measure's renders are no part of the reconstruction.
     let t_measured = Instant::now();
 
-    let image = RgbImage {
-        width: w as usize,
-        height: h as usize,
-        pixels: plugins.image(&film),
-    };
+    let image = plugins.image(&film);
     let t_reconstructed = Instant::now();
-    let fit_partition = plugins.filter.fit_partition();
-    if args.mergeable {
-        let scale = f64::from(scene.film.scale);
-        let sums = film
-            .weighted_sums()
-            .ok_or("--mergeable: the film has no sums")?;
-        let merged = Sums {
-            frame,
-            width: w as usize,
-            height: h as usize,
-            sums: sums
-                .iter()
-                .map(|s| [s[0] * scale, s[1] * scale, s[2] * scale, s[3]])
-                .collect(),
-            counts: film
-                .pixel_stats()
-                .iter()
-                .map(|p| f64::from(p.count))
-                .collect(),
-            spp,
-            seconds: (t_rendered - t_built).as_secs_f64(),
-        };
-        merged
-            .write(&output)
-            .map_err(|e| format!("{}: {e}", output.display()))?;
-    } else {
-        write_atomically(&output, &image, frame)?;
+    if let Some(d) = &display {
+        d.show(&image);
     }
-    for a in &aovs {
+    let fit_partition = plugins.filter.fit_partition();
+    let signalled = counts.halted_by == Some(Halt::Signal);
+    let end = End {
+        spp,
+        halted: counts.halted,
+        signalled,
+        seconds: (t_rendered - t_built).as_secs_f64(),
+        features: features.as_ref(),
+    };
+    out.write_final(&image, &film, &end)?;
+    for a in aovs.iter().filter(|a| !out.holds(a)) {
         let line = write_aov(
             a,
             w as usize,
@@ -563,11 +612,23 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             counts.dropped, counts.samples
         );
     }
-    if counts.halted_by == Some(Halt::Signal) {
+    if signalled {
+        let reached = reached_spp(film.pixel_stats());
+        let resume = if out.can_merge {
+            format!(
+                "a mergeable EXR of sample indices {}..{}: render the rest with --sample-offset \
+                 {} --spp {} --mergeable and `acr merge` the two",
+                args.sample_offset,
+                args.sample_offset + reached,
+                args.sample_offset + reached,
+                spp.saturating_sub(reached)
+            )
+        } else {
+            "render again to finish it".to_owned()
+        };
         return Err(format!(
-            "interrupted by a signal after {} of {spp} samples per pixel; the image so far is in \
-             {} (render the rest and merge, or render again)",
-            counts.samples / (u64::from(w) * u64::from(h)).max(1),
+            "interrupted by a signal after {reached} of {spp} samples per pixel; the image so \
+             far is in {} ({resume})",
             output.display()
         ));
     }
@@ -616,23 +677,6 @@ fn quarter_resolution(desc: &mut SceneDescription) -> acr_parser::Result<()> {
             .push(Param::new(ParamType::Integer, name, quarter, loc.clone()));
     }
     Ok(())
-}
-
-/// Writes `image` to `output` through a temporary file in the same folder and a rename, so
-/// that a reader (or a kill mid-write) never sees half a file.
-fn write_atomically(output: &Path, image: &RgbImage, frame: Frame) -> Result<(), String> {
-    let name = output
-        .file_name()
-        .map_or_else(|| "image".into(), |n| n.to_string_lossy().into_owned());
-    let ext = output
-        .extension()
-        .map_or_else(String::new, |e| e.to_string_lossy().into_owned());
-    let temp = output.with_file_name(format!(".{name}.{}.partial.{ext}", std::process::id()));
-    write_image_in_frame(&temp, image, frame).map_err(|e| format!("{}: {e}", temp.display()))?;
-    std::fs::rename(&temp, output).map_err(|e| {
-        let _ = std::fs::remove_file(&temp);
-        format!("{}: cannot write: {e}", output.display())
-    })
 }
 
 /// Fails early, before the render, when the output cannot be written (unknown format or a

@@ -60,6 +60,10 @@ impl Sampler for Recording<'_> {
         self.inner.plans_ahead()
     }
 
+    fn whole_passes(&self) -> bool {
+        self.inner.whole_passes()
+    }
+
     fn streams(&self) -> u32 {
         self.inner.streams()
     }

@@ -82,6 +82,13 @@ pub trait Sampler: Send {
         false
     }
 
+    /// Whether its batches come in passes over every pixel of the space, row-major, each
+    /// pass's last batch ending at the last pixel (so that the film holds whole passes when
+    /// the last batch handed over ends there). By default, no.
+    fn whole_passes(&self) -> bool {
+        false
+    }
+
     /// Gives sample indices `offset` to `offset + spp` of each pixel instead of 0 to `spp`
     /// (Cycles' sample offset), so that renders of consecutive ranges add up to one of them
     /// all. Only a sampler whose points depend on the index alone can; it says whether it did.
@@ -385,6 +392,10 @@ impl<T: PixelPattern> Sampler for T {
 
     fn plans_ahead(&self) -> bool {
         // Its points depend on nothing it observes.
+        true
+    }
+
+    fn whole_passes(&self) -> bool {
         true
     }
 
