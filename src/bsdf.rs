@@ -249,6 +249,8 @@ pub enum Bxdf {
     Hair(crate::hair::HairBsdf),
     /// A lobe of pbrt-v3's Disney BSDF (`src/disney.rs`).
     Disney(crate::disney::DisneyBxdf),
+    /// pbrt-v3's tabulated `FourierBSDF` (the fourier material, `src/fourier.rs`).
+    Fourier(crate::fourier::FourierBsdf),
 }
 
 impl Bxdf {
@@ -279,6 +281,7 @@ impl Bxdf {
             Bxdf::MicrofacetTransmission { .. } => T::TRANSMISSION.or(T::GLOSSY),
             Bxdf::Hair(_) => T::REFLECTION.or(T::TRANSMISSION).or(T::GLOSSY),
             Bxdf::Disney(d) => d.kind(),
+            Bxdf::Fourier(_) => T::REFLECTION.or(T::TRANSMISSION).or(T::GLOSSY),
         }
     }
 
@@ -411,6 +414,7 @@ impl Bxdf {
             }
             Bxdf::Hair(h) => h.f(wo, wi),
             Bxdf::Disney(d) => d.f(wo, wi),
+            Bxdf::Fourier(t) => t.f(wo, wi),
         }
     }
 
@@ -586,6 +590,10 @@ impl Bxdf {
                 LobeSample { wi, f, pdf, kind }
             }
             Bxdf::Disney(d) => d.sample_f(wo, u)?,
+            Bxdf::Fourier(t) => {
+                let (wi, f, pdf) = t.sample_f(wo, [u.x, u.y])?;
+                LobeSample { wi, f, pdf, kind }
+            }
         };
         if s.pdf > 0.0 && s.pdf.is_finite() && s.f.is_finite() && s.wi.is_finite() {
             Some(s)
@@ -660,6 +668,7 @@ impl Bxdf {
             }
             Bxdf::Hair(h) => h.pdf(wo, wi),
             Bxdf::Disney(d) => d.pdf(wo, wi),
+            Bxdf::Fourier(t) => t.pdf(wo, wi),
         };
         if p.is_finite() && p > 0.0 {
             p
@@ -805,6 +814,7 @@ impl Bsdf {
                     Bxdf::FresnelBlend { rd, rs, .. } => rd + rs,
                     Bxdf::Hair(h) => h.albedo(),
                     Bxdf::Disney(d) => d.albedo(),
+                    Bxdf::Fourier(t) => t.table.albedo(),
                 };
                 nominal * l.scale
             })

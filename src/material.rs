@@ -23,7 +23,7 @@ pub const COPPER_ETA: Spectrum = Spectrum::new(0.200438, 0.924033, 1.10221);
 pub const COPPER_K: Spectrum = Spectrum::new(3.91295, 2.45285, 2.14219);
 
 /// Material types acr builds.
-const KINDS: [&str; 11] = [
+const KINDS: [&str; 12] = [
     "matte",
     "translucent",
     "plastic",
@@ -35,9 +35,10 @@ const KINDS: [&str; 11] = [
     "hair",
     "disney",
     "mix",
+    "fourier",
 ];
 /// pbrt-v3 material types acr replaces by a matte.
-const UNSUPPORTED_KINDS: [&str; 3] = ["subsurface", "kdsubsurface", "fourier"];
+const UNSUPPORTED_KINDS: [&str; 2] = ["subsurface", "kdsubsurface"];
 /// Types that make no surface: rays pass through.
 const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
 /// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
@@ -158,6 +159,8 @@ pub enum Material {
     /// absorption from `sigma_a`, `color` or melanin concentrations, `eta`, `beta_m`, `beta_n`,
     /// `alpha`.
     Hair(crate::hair::HairMaterial),
+    /// pbrt-v3's `fourier`: a BSDF tabulated in a `.bsdf` file.
+    Fourier(crate::fourier::FourierBsdf),
     /// pbrt-v3's `disney` ([`crate::disney`]).
     Disney(Box<crate::disney::DisneyMaterial>),
     /// pbrt-v3's mix: the lobes of `materials[0]` weighted by `amount`, those of `materials[1]`
@@ -567,6 +570,9 @@ impl Material {
             // pbrt-v3's Disney BSDF keeps the relative index 1 (its transmission is rough, and
             // only a specular one scales Russian roulette by it).
             Material::Disney(d) => d.add_lobes(si, b, scale),
+            Material::Fourier(f) => {
+                b.add_scaled(Bxdf::Fourier(*f), scale);
+            }
             Material::Mix { amount, materials } => {
                 let s1 = clamp0(amount.eval(si));
                 let s2 = clamp0(Spectrum::ONE - s1);
@@ -704,6 +710,16 @@ impl<'a> MaterialBuilder<'a> {
                 remap_roughness: remap(p)?,
             },
             "hair" => Material::Hair(crate::hair::HairMaterial::from_params(t, p, loc)?),
+            "fourier" => {
+                let Some(name) = p.string("bsdffile")? else {
+                    return Err(Error::at(loc, "fourier material needs \"string bsdffile\""));
+                };
+                let at = p.get("bsdffile").map_or(loc, |x| &x.loc).clone();
+                let path = t.resolve_file(name, &at);
+                let table = crate::fourier::FourierTable::load(&path)
+                    .map_err(|e| Error::at(&at, format!("fourier material: {e}")))?;
+                Material::Fourier(crate::fourier::FourierBsdf { table })
+            }
             "disney" => Material::Disney(Box::new(crate::disney::DisneyMaterial::from_params(
                 t, p, loc,
             )?)),

@@ -707,6 +707,11 @@ impl Build for Spectrum {
 }
 
 impl<'a> TextureBuilder<'a> {
+    /// A file named in the scene at `loc`, found as [`resolve_file`] finds it.
+    pub fn resolve_file(&self, name: &str, loc: &Loc) -> PathBuf {
+        resolve_file(name, loc, &self.main_dir)
+    }
+
     /// A builder for `desc`'s textures; `main_dir` is the main scene file's directory.
     pub fn new(desc: &'a SceneDescription, main_dir: &Path) -> Self {
         let n = desc.textures.len();

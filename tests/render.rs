@@ -345,6 +345,7 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("image-lights.pbrt", "image-lights", 16),
     ("disney.pbrt", "disney", 16),
     ("hair.pbrt", "hair", 16),
+    ("fourier.pbrt", "fourier", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

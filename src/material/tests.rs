@@ -293,10 +293,15 @@ fn unsupported_parameters_warn_once_and_unknown_types_fail() {
     assert!(matches!(e, Error::At { .. }));
 
     let (m, w) = build(&format!(
-        "Material \"fourier\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
+        "Material \"subsurface\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
     ));
     assert_eq!(w.len(), 1);
     assert!(matches!(m.last().unwrap(), Material::Matte { .. }));
+    // fourier reads its table (issue 27): without one, a located error.
+    let e = build_err(&format!(
+        "Material \"fourier\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
+    ));
+    assert!(e.message().contains("bsdffile"), "{e}");
 
     // translucent (issue 27): pbrt-v3's four lobes with its defaults, index 1.5.
     let (m, w) = build(&format!("Material \"translucent\"\n{SHAPE}"));
