@@ -905,6 +905,37 @@ impl Bsdf {
         })
     }
 
+    /// Samples specular lobe `index` alone, as pbrt-v3's `SpecularReflect` and
+    /// `SpecularTransmit` ask `BSDF::Sample_f` for one type: its weighted value and its own
+    /// probability. `None` for a lobe that is not specular or gives nothing.
+    pub fn sample_specular_lobe(
+        &self,
+        wo_world: Vec3,
+        u: Vec2,
+        index: usize,
+    ) -> Option<BsdfSample> {
+        let lobe = self.lobes().get(index)?;
+        if !lobe.bxdf.is_specular() {
+            return None;
+        }
+        let wo = self.frame.to_local(wo_world);
+        if wo.z == 0.0 {
+            return None;
+        }
+        let s = lobe.bxdf.sample_f(wo, u)?;
+        let wi = self.frame.from_local(s.wi);
+        let f = lobe.scale * s.f;
+        if !(s.pdf > 0.0 && s.pdf.is_finite() && f.is_finite() && wi.is_finite()) {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f,
+            pdf: s.pdf,
+            specular: true,
+        })
+    }
+
     /// Density with which [`Bsdf::sample_f`] picks world direction `wi` given `wo` (specular
     /// lobes count as zero).
     pub fn pdf(&self, wo_world: Vec3, wi_world: Vec3) -> f32 {

@@ -3,11 +3,11 @@
 //! v, and the shading normal becomes their cross product, turned to the geometric normal's
 //! side.
 //!
-//! Two simplifications against pbrt-v3: the finite-difference steps are pbrt-v3's fallback for
-//! rays without differentials, du = dv = 0.0005 (acr traces no ray differentials; pbrt-v3
-//! takes half the footprint in u and v on camera rays), and on triangle meshes the normal's
-//! derivatives are zero (pbrt-v3 differentiates the vertex normals; the quadrics' come from
-//! the Weingarten equations as in pbrt-v3).
+//! The finite-difference steps are pbrt-v3's: half the hit's footprint in u and v, from the
+//! camera ray's differentials (du = (|du/dx| + |du/dy|) / 2), and 0.0005 where there is none
+//! (later bounces). One simplification: on triangle meshes the normal's derivatives are zero
+//! (pbrt-v3 differentiates the vertex normals; the quadrics' come from the Weingarten equations
+//! as in pbrt-v3).
 
 use crate::geometry::SurfaceInteraction;
 use crate::texture::FloatTexture;
@@ -15,23 +15,35 @@ use crate::texture::FloatTexture;
 /// pbrt-v3's step in u and v when a ray carries no differentials.
 const STEP: f32 = 0.0005;
 
+/// pbrt-v3's step: half the footprint `(|dx| + |dy|) / 2`, else [`STEP`].
+fn step(dx: f32, dy: f32) -> f32 {
+    let s = 0.5 * (dx.abs() + dy.abs());
+    if s == 0.0 {
+        STEP
+    } else {
+        s
+    }
+}
+
 /// The interaction `si` with its shading geometry bumped by the displacement texture `d`.
 pub fn bump(d: &FloatTexture, si: &SurfaceInteraction) -> SurfaceInteraction {
     let (dpdu, dpdv) = (si.shading_dpdu, si.shading_dpdv);
+    let du = step(si.diff.dudx, si.diff.dudy);
+    let dv = step(si.diff.dvdx, si.diff.dvdy);
     let mut eval = *si;
     // Shifted in u.
-    eval.p = si.p + STEP * dpdu;
-    eval.uv = si.uv + glam::Vec2::new(STEP, 0.0);
+    eval.p = si.p + du * dpdu;
+    eval.uv = si.uv + glam::Vec2::new(du, 0.0);
     let u_displace = d.eval(&eval);
     // Shifted in v.
-    eval.p = si.p + STEP * dpdv;
-    eval.uv = si.uv + glam::Vec2::new(0.0, STEP);
+    eval.p = si.p + dv * dpdv;
+    eval.uv = si.uv + glam::Vec2::new(0.0, dv);
     let v_displace = d.eval(&eval);
     let displace = d.eval(si);
 
     let n = si.shading_n;
-    let bumped_dpdu = dpdu + (u_displace - displace) / STEP * n + displace * si.dndu;
-    let bumped_dpdv = dpdv + (v_displace - displace) / STEP * n + displace * si.dndv;
+    let bumped_dpdu = dpdu + (u_displace - displace) / du * n + displace * si.dndu;
+    let bumped_dpdv = dpdv + (v_displace - displace) / dv * n + displace * si.dndv;
     let ns = bumped_dpdu.cross(bumped_dpdv).normalize_or_zero();
     let mut out = *si;
     if !ns.is_finite() || ns == glam::Vec3::ZERO {
@@ -150,6 +162,7 @@ mod tests {
                 wo: -n,
                 time: 0.0,
                 p_error: 0.0,
+                diff: Default::default(),
             };
             let got = bump(&d, &hit).shading_n;
             let want = Vec3::from_array(want);

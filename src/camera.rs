@@ -3,7 +3,7 @@
 //! in latitude-longitude), with a shutter interval and a camera transform that may move.
 //! pbrt-v3's `realistic` (a lens system read from a file) is refused with a located error.
 
-use crate::geometry::{Ray, Vec2, Vec3};
+use crate::geometry::{Ray, RayDifferentials, Vec2, Vec3};
 use crate::sampling::concentric_sample_disk;
 use crate::transform::MotionTransform;
 use acr_parser::{CameraDesc, Error, Result};
@@ -167,14 +167,55 @@ impl Camera {
 
     /// The world-space ray for a camera sample (direction normalised).
     pub fn generate_ray(&self, s: &CameraSample) -> Ray {
-        let p = self.raster_to_camera * Vec4::new(s.film.x, s.film.y, 0.0, 1.0);
+        let time = self.time(s);
+        let m = self.world_from_camera.at(time);
+        let (o, d) = self.camera_space_ray(s.film, s.lens);
+        Ray::new(
+            m.transform_point3(o),
+            m.transform_vector3(d).normalize(),
+            time,
+        )
+    }
+
+    /// The ray for a camera sample and its differentials: the rays through the film point one
+    /// pixel right and one pixel down, with the same lens point and time (pbrt-v3's
+    /// perspective and orthographic cameras compute the same rays in closed form; its
+    /// environment camera shifts the film point as here).
+    pub fn generate_ray_differential(&self, s: &CameraSample) -> (Ray, RayDifferentials) {
+        let time = self.time(s);
+        let m = self.world_from_camera.at(time);
+        let world =
+            |(o, d): (Vec3, Vec3)| (m.transform_point3(o), m.transform_vector3(d).normalize());
+        let (o, d) = world(self.camera_space_ray(s.film, s.lens));
+        let (rx_o, rx_d) = world(self.camera_space_ray(s.film + Vec2::X, s.lens));
+        let (ry_o, ry_d) = world(self.camera_space_ray(s.film + Vec2::Y, s.lens));
+        (
+            Ray::new(o, d, time),
+            RayDifferentials {
+                rx_o,
+                rx_d,
+                ry_o,
+                ry_d,
+            },
+        )
+    }
+
+    /// The sample's time within the shutter.
+    fn time(&self, s: &CameraSample) -> f32 {
+        self.shutter_open + s.time * (self.shutter_close - self.shutter_open)
+    }
+
+    /// The camera-space ray through raster point `film` and lens sample `lens` (direction
+    /// normalised).
+    fn camera_space_ray(&self, film: Vec2, lens: Vec2) -> (Vec3, Vec3) {
+        let p = self.raster_to_camera * Vec4::new(film.x, film.y, 0.0, 1.0);
         let p_camera = p.truncate() / p.w;
         let (mut o, mut d) = match self.projection {
             Projection::Perspective => (Vec3::ZERO, p_camera.normalize()),
             Projection::Orthographic => (p_camera, Vec3::Z),
             Projection::Environment => {
-                let theta = std::f32::consts::PI * s.film.y / self.resolution.1;
-                let phi = 2.0 * std::f32::consts::PI * s.film.x / self.resolution.0;
+                let theta = std::f32::consts::PI * film.y / self.resolution.1;
+                let phi = 2.0 * std::f32::consts::PI * film.x / self.resolution.0;
                 let d = Vec3::new(
                     theta.sin() * phi.cos(),
                     theta.cos(),
@@ -184,7 +225,7 @@ impl Camera {
             }
         };
         if self.lens_radius > 0.0 {
-            let lens = self.lens_radius * concentric_sample_disk(s.lens);
+            let lens = self.lens_radius * concentric_sample_disk(lens);
             let ft = self.focal_distance / d.z;
             let focus = o + d * ft;
             // pbrt-v3's orthographic camera, too, puts the lens point at (lens.x, lens.y, 0),
@@ -192,13 +233,7 @@ impl Camera {
             o = Vec3::new(lens.x, lens.y, 0.0);
             d = (focus - o).normalize();
         }
-        let time = self.shutter_open + s.time * (self.shutter_close - self.shutter_open);
-        let m = self.world_from_camera.at(time);
-        Ray::new(
-            m.transform_point3(o),
-            m.transform_vector3(d).normalize(),
-            time,
-        )
+        (o, d)
     }
 }
 

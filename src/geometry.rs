@@ -112,6 +112,53 @@ pub struct SurfaceInteraction {
     /// How far off the surface spawned rays start, beyond the rounding offset: pbrt-v3's error
     /// bound where it is large (two widths on curves, which face every ray); 0 elsewhere.
     pub p_error: f32,
+    /// How the point and (u, v) change from pixel to pixel (zero unless the ray came from the
+    /// camera with differentials).
+    pub diff: SurfaceDifferentials,
+}
+
+/// The rays through the next pixel right and the next pixel down (pbrt-v3's
+/// `RayDifferential`), scaled to the sample spacing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RayDifferentials {
+    /// Origin of the ray one pixel right.
+    pub rx_o: Vec3,
+    /// Its direction.
+    pub rx_d: Vec3,
+    /// Origin of the ray one pixel down.
+    pub ry_o: Vec3,
+    /// Its direction.
+    pub ry_d: Vec3,
+}
+
+impl RayDifferentials {
+    /// Scales the offsets from `ray` by `s` (pbrt-v3's `ScaleDifferentials`: 1 / sqrt(spp)).
+    pub fn scaled(self, ray: &Ray, s: f32) -> Self {
+        Self {
+            rx_o: ray.o + (self.rx_o - ray.o) * s,
+            ry_o: ray.o + (self.ry_o - ray.o) * s,
+            rx_d: ray.d + (self.rx_d - ray.d) * s,
+            ry_d: ray.d + (self.ry_d - ray.d) * s,
+        }
+    }
+}
+
+/// The screen-space derivatives of a hit's position and (u, v) (pbrt-v3's `dpdx`, `dpdy`,
+/// `dudx`, `dvdx`, `dudy`, `dvdy`), from its ray's differentials.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfaceDifferentials {
+    /// dp/dx.
+    pub dpdx: Vec3,
+    /// dp/dy.
+    pub dpdy: Vec3,
+    /// du/dx.
+    pub dudx: f32,
+    /// dv/dx.
+    pub dvdx: f32,
+    /// du/dy.
+    pub dudy: f32,
+    /// dv/dy.
+    pub dvdy: f32,
 }
 
 /// Offsets a point off a surface so that a ray leaving it does not hit that surface again.
@@ -168,7 +215,61 @@ impl SurfaceInteraction {
             wo: Vec3::Z,
             time: 0.0,
             p_error: 0.0,
+            diff: SurfaceDifferentials::default(),
         }
+    }
+
+    /// pbrt-v3's `ComputeDifferentials`: where the offset rays meet the tangent plane, and the
+    /// (u, v) steps that reach those points, by least squares over the two coordinates the
+    /// normal leaves best conditioned. Zero when an offset ray runs parallel to the plane.
+    pub fn compute_differentials(&mut self, rd: &RayDifferentials) {
+        let n = self.n;
+        let d = n.dot(self.p);
+        let tx = -(n.dot(rd.rx_o) - d) / n.dot(rd.rx_d);
+        let ty = -(n.dot(rd.ry_o) - d) / n.dot(rd.ry_d);
+        if !tx.is_finite() || !ty.is_finite() {
+            self.diff = SurfaceDifferentials::default();
+            return;
+        }
+        let px = rd.rx_o + tx * rd.rx_d;
+        let py = rd.ry_o + ty * rd.ry_d;
+        let (dpdx, dpdy) = (px - self.p, py - self.p);
+        let dim = if n.x.abs() > n.y.abs() && n.x.abs() > n.z.abs() {
+            [1, 2]
+        } else if n.y.abs() > n.z.abs() {
+            [0, 2]
+        } else {
+            [0, 1]
+        };
+        let a = [
+            [self.dpdu[dim[0]], self.dpdv[dim[0]]],
+            [self.dpdu[dim[1]], self.dpdv[dim[1]]],
+        ];
+        let bx = [dpdx[dim[0]], dpdx[dim[1]]];
+        let by = [dpdy[dim[0]], dpdy[dim[1]]];
+        let solve = |b: [f32; 2]| -> (f32, f32) {
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            if det.abs() < 1e-10 {
+                return (0.0, 0.0);
+            }
+            let x0 = (a[1][1] * b[0] - a[0][1] * b[1]) / det;
+            let x1 = (a[0][0] * b[1] - a[1][0] * b[0]) / det;
+            if !x0.is_nan() && !x1.is_nan() {
+                (x0, x1)
+            } else {
+                (0.0, 0.0)
+            }
+        };
+        let (dudx, dvdx) = solve(bx);
+        let (dudy, dvdy) = solve(by);
+        self.diff = SurfaceDifferentials {
+            dpdx,
+            dpdy,
+            dudx,
+            dvdx,
+            dudy,
+            dvdy,
+        };
     }
 
     /// The geometric normal flipped to the side of `w`.

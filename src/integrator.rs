@@ -7,7 +7,7 @@
 //! expectation, one ray fewer per bounce.
 
 use crate::features::{FirstHit, FirstHitProbe};
-use crate::geometry::{Ray, Spectrum, SurfaceInteraction};
+use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::sampling::power_heuristic;
@@ -176,20 +176,35 @@ impl Integrator {
         }
     }
 
-    /// Radiance arriving along `ray`.
-    pub fn li(&self, scene: &Scene, ray: Ray, stream: &mut SampleStream) -> Radiance {
+    /// Radiance arriving along `ray`; `diff`, a camera ray's differentials, give the first hit
+    /// its screen-space derivatives (for texture filtering and bump mapping, as pbrt-v3).
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        diff: Option<&RayDifferentials>,
+        stream: &mut SampleStream,
+    ) -> Radiance {
         match *self {
             Integrator::Path {
                 max_depth,
                 rr_threshold,
                 light_strategy,
-            } => path_li(scene, ray, stream, max_depth, rr_threshold, light_strategy),
+            } => path_li(
+                scene,
+                ray,
+                diff,
+                stream,
+                max_depth,
+                rr_threshold,
+                light_strategy,
+            ),
             Integrator::Direct {
                 max_depth,
                 strategy,
             } => {
                 let mut tally = Tally::default();
-                let l = direct_li(scene, ray, stream, max_depth, 0, strategy, &mut tally);
+                let l = direct_li(scene, ray, diff, stream, max_depth, 0, strategy, &mut tally);
                 Radiance {
                     l,
                     rays: tally.rays,
@@ -240,6 +255,7 @@ fn sample_light(
 fn path_li(
     scene: &Scene,
     mut ray: Ray,
+    mut diff: Option<&RayDifferentials>,
     stream: &mut SampleStream,
     max_depth: u32,
     rr_threshold: f32,
@@ -278,7 +294,12 @@ fn path_li(
             }
             break;
         };
-        let si = hit.si;
+        let mut si = hit.si;
+        // Only the camera ray has differentials (pbrt-v3's path integrator spawns every later
+        // ray, and the one through an interface, without them).
+        if let Some(d) = diff.take() {
+            si.compute_differentials(d);
+        }
         probe.travel(ray.o, si.p);
         if let Some(li) = hit.surface.area_light {
             let light = &scene.lights[li as usize];
@@ -390,12 +411,14 @@ struct Tally {
 }
 
 /// pbrt-v3's DirectLightingIntegrator: emission, direct light at the first non-specular hit
-/// (MIS of light and BSDF sampling), and specular reflection and transmission recursively.
-/// Specular recursion follows one sampled specular lobe per level (pbrt-v3 traces reflection
-/// and transmission separately); same expectation.
+/// (MIS of light and BSDF sampling), and specular reflection and transmission recursively,
+/// every specular lobe followed as pbrt-v3 does, the camera ray's differentials carried
+/// through them.
+#[allow(clippy::too_many_arguments)]
 fn direct_li(
     scene: &Scene,
     ray: Ray,
+    diff: Option<&RayDifferentials>,
     stream: &mut SampleStream,
     max_depth: u32,
     depth: u32,
@@ -425,7 +448,13 @@ fn direct_li(
             Some(h) => break h,
         }
     };
-    let si = hit.si;
+    let mut si = hit.si;
+    // The differentials hold for the ray as it left the camera (or a specular bounce), not
+    // through an interface.
+    let camera_diff = diff.filter(|_| pass_through == 0);
+    if let Some(d) = camera_diff {
+        si.compute_differentials(d);
+    }
     let mut l = Spectrum::ZERO;
     if let Some(li) = hit.surface.area_light {
         l += scene.lights[li as usize].l(&si, si.wo);
@@ -435,7 +464,9 @@ fn direct_li(
     };
     let material = &scene.materials[material as usize];
     let si = material.shading(&si);
-    let bsdf = material.bsdf(&si);
+    // pbrt-v3's DirectLightingIntegrator asks for separate lobes (a glass's reflection and
+    // transmission apart), and follows each.
+    let bsdf = material.bsdf_with(&si, false);
     tally.probe.surface(&si, &bsdf);
     if bsdf.has_non_specular() && !scene.lights.is_empty() {
         match strategy {
@@ -470,21 +501,85 @@ fn direct_li(
             }
         }
     }
+    // pbrt-v3's SpecularReflect and SpecularTransmit: every specular lobe is followed (a
+    // glass's reflection and its transmission both), each with its own sample.
     if depth + 1 < max_depth {
-        let u_lobe = stream.next_1d();
-        let u = stream.next_2d();
-        if let Some(s) = bsdf.sample_f(si.wo, u, u_lobe) {
-            if s.specular && s.pdf > 0.0 {
-                let weight = s.f * s.wi.dot(si.shading_n).abs() / s.pdf;
-                if weight != Spectrum::ZERO && crate::geometry::is_valid_radiance(weight) {
-                    let next = si.spawn_ray(s.wi);
-                    l += weight
-                        * direct_li(scene, next, stream, max_depth, depth + 1, strategy, tally);
-                }
+        for index in 0..bsdf.num_lobes() {
+            let u = stream.next_2d();
+            let Some(s) = bsdf.sample_specular_lobe(si.wo, u, index) else {
+                continue;
+            };
+            let cos = s.wi.dot(si.shading_n).abs();
+            let weight = s.f * cos / s.pdf;
+            if cos == 0.0 || weight == Spectrum::ZERO || !crate::geometry::is_valid_radiance(weight)
+            {
+                continue;
             }
+            let next = si.spawn_ray(s.wi);
+            let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
+            let next_diff =
+                camera_diff.map(|d| specular_differentials(d, &si, s.wi, transmitted, bsdf.eta()));
+            l += weight
+                * direct_li(
+                    scene,
+                    next,
+                    next_diff.as_ref(),
+                    stream,
+                    max_depth,
+                    depth + 1,
+                    strategy,
+                    tally,
+                );
         }
     }
     l
+}
+
+/// The differentials of the ray leaving `si` along `wi` by specular reflection or transmission,
+/// from those of the ray that arrived (`d`): pbrt-v3's `SpecularReflect` and
+/// `SpecularTransmit`, which follow the footprint through mirrors and glass (with the normal's
+/// change across it, from dn/du and dn/dv).
+fn specular_differentials(
+    d: &RayDifferentials,
+    si: &SurfaceInteraction,
+    wi: crate::geometry::Vec3,
+    transmitted: bool,
+    bsdf_eta: f32,
+) -> RayDifferentials {
+    let wo = si.wo;
+    let mut ns = si.shading_n;
+    let f = &si.diff;
+    let mut dndx = si.dndu * f.dudx + si.dndv * f.dvdx;
+    let mut dndy = si.dndu * f.dudy + si.dndv * f.dvdy;
+    let (rx_o, ry_o) = (si.p + f.dpdx, si.p + f.dpdy);
+    let (dwodx, dwody) = (-d.rx_d - wo, -d.ry_d - wo);
+    if !transmitted {
+        let ddndx = dwodx.dot(ns) + wo.dot(dndx);
+        let ddndy = dwody.dot(ns) + wo.dot(dndy);
+        return RayDifferentials {
+            rx_o,
+            ry_o,
+            rx_d: wi - dwodx + 2.0 * (wo.dot(ns) * dndx + ddndx * ns),
+            ry_d: wi - dwody + 2.0 * (wo.dot(ns) * dndy + ddndy * ns),
+        };
+    }
+    let mut eta = 1.0 / bsdf_eta;
+    if wo.dot(ns) < 0.0 {
+        eta = 1.0 / eta;
+        ns = -ns;
+        dndx = -dndx;
+        dndy = -dndy;
+    }
+    let ddndx = dwodx.dot(ns) + wo.dot(dndx);
+    let ddndy = dwody.dot(ns) + wo.dot(dndy);
+    let mu = eta * wo.dot(ns) - wi.dot(ns).abs();
+    let k = eta - (eta * eta * wo.dot(ns)) / wi.dot(ns).abs();
+    RayDifferentials {
+        rx_o,
+        ry_o,
+        rx_d: wi - eta * dwodx + (mu * dndx + k * ddndx * ns),
+        ry_d: wi - eta * dwody + (mu * dndy + k * ddndy * ns),
+    }
 }
 
 /// pbrt-v3's EstimateDirect: a light sample and a BSDF sample, combined by MIS.

@@ -24,6 +24,7 @@ pub mod lightdistrib;
 pub mod material;
 pub mod metrics;
 pub mod microfacet;
+pub mod mipmap;
 pub mod noise;
 pub mod procedural;
 pub mod registry;

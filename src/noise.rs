@@ -2,10 +2,9 @@
 //! quintic weights, and the fractional Brownian motion and turbulence sums built on it, so that
 //! the procedural textures match pbrt-v3's images.
 //!
-//! pbrt-v3 limits the octaves by the ray differentials' footprint; acr traces no ray
-//! differentials, so every lookup takes all `octaves`, which is what pbrt-v3 does for rays
-//! without differentials (its indirect rays). On camera rays pbrt-v3 drops the octaves finer
-//! than the pixel footprint (each an amplitude of `roughness`^k of the first).
+//! As pbrt-v3, the octaves stop at the footprint of the hit (`dpdx`, `dpdy`, from the camera
+//! ray's differentials): finer octaves would alias; the last one fades in. Without
+//! differentials (later bounces) every octave is summed.
 
 use crate::geometry::Vec3;
 
@@ -91,30 +90,50 @@ pub fn noise3(p: Vec3) -> f32 {
     noise(p.x, p.y, p.z)
 }
 
-/// pbrt-v3's `FBm` without a footprint: `octaves` octaves of noise, each at 1.99 times the
-/// frequency and `omega` times the amplitude of the one before.
-pub fn fbm(p: Vec3, omega: f32, octaves: u32) -> f32 {
+/// The octaves pbrt-v3 sums for a footprint: `-1 - log2(|dp|^2) / 2`, within [0, `max`]
+/// (`max` for no footprint).
+fn octave_count(dpdx: Vec3, dpdy: Vec3, max: u32) -> f32 {
+    let len2 = dpdx.length_squared().max(dpdy.length_squared());
+    let n = -1.0 - 0.5 * (len2.ln() * std::f32::consts::LOG2_E);
+    if n.is_nan() {
+        return 0.0;
+    }
+    n.clamp(0.0, max as f32)
+}
+
+/// pbrt-v3's `FBm`: octaves of noise, each at 1.99 times the frequency and `omega` times the
+/// amplitude of the one before, as many as the footprint (`dpdx`, `dpdy`) allows up to
+/// `max_octaves`, the last partial one faded in.
+pub fn fbm(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: u32) -> f32 {
+    let n = octave_count(dpdx, dpdy, max_octaves);
+    let whole = n.floor() as u32;
     let (mut sum, mut lambda, mut o) = (0.0, 1.0f32, 1.0);
-    for _ in 0..octaves {
+    for _ in 0..whole {
         sum += o * noise3(lambda * p);
         lambda *= 1.99;
         o *= omega;
     }
-    // pbrt-v3's partial octave, SmoothStep(.3, .7, 0) = 0 here: nothing to add.
-    sum
+    sum + o * smooth_step(0.3, 0.7, n - whole as f32) * noise3(lambda * p)
 }
 
-/// pbrt-v3's `Turbulence` without a footprint: as [`fbm`] with the absolute value of each
-/// octave, plus pbrt-v3's partial-octave term, which is 0.2 times the next amplitude when no
-/// octave is clamped.
-pub fn turbulence(p: Vec3, omega: f32, octaves: u32) -> f32 {
+/// pbrt-v3's `Turbulence`: as [`fbm`] with the absolute value of each octave, and the octaves
+/// the footprint leaves out counted at their mean, 0.2 times their amplitude.
+pub fn turbulence(p: Vec3, dpdx: Vec3, dpdy: Vec3, omega: f32, max_octaves: u32) -> f32 {
+    let n = octave_count(dpdx, dpdy, max_octaves);
+    let whole = n.floor() as u32;
     let (mut sum, mut lambda, mut o) = (0.0, 1.0f32, 1.0);
-    for _ in 0..octaves {
+    for _ in 0..whole {
         sum += o * noise3(lambda * p).abs();
         lambda *= 1.99;
         o *= omega;
     }
-    sum + o * 0.2
+    let partial = smooth_step(0.3, 0.7, n - whole as f32);
+    sum += o * (0.2 + partial * (noise3(lambda * p).abs() - 0.2));
+    for _ in whole..max_octaves {
+        sum += o * 0.2;
+        o *= omega;
+    }
+    sum
 }
 
 #[cfg(test)]
@@ -154,7 +173,11 @@ mod tests {
         ];
         for (p, want) in cases {
             let p = Vec3::from_array(p);
-            let got = [noise3(p), fbm(p, 0.5, 8), turbulence(p, 0.5, 8)];
+            let got = [
+                noise3(p),
+                fbm(p, Vec3::ZERO, Vec3::ZERO, 0.5, 8),
+                turbulence(p, Vec3::ZERO, Vec3::ZERO, 0.5, 8),
+            ];
             for (g, w) in got.iter().zip(want) {
                 assert!((g - w).abs() < 2e-6, "{p}: {got:?} against {want:?}");
             }
@@ -167,11 +190,11 @@ mod tests {
     #[test]
     fn fbm_and_turbulence_sum_their_octaves() {
         let p = Vec3::new(0.3, 1.7, -2.2);
-        assert_eq!(fbm(p, 0.5, 1), noise3(p));
+        assert_eq!(fbm(p, Vec3::ZERO, Vec3::ZERO, 0.5, 1), noise3(p));
         let two = noise3(p) + 0.5 * noise3(1.99 * p);
-        assert!((fbm(p, 0.5, 2) - two).abs() < 1e-6);
+        assert!((fbm(p, Vec3::ZERO, Vec3::ZERO, 0.5, 2) - two).abs() < 1e-6);
         let t = noise3(p).abs() + 0.5 * 0.2;
-        assert!((turbulence(p, 0.5, 1) - t).abs() < 1e-6);
-        assert!(turbulence(p, 0.5, 8) > 0.0);
+        assert!((turbulence(p, Vec3::ZERO, Vec3::ZERO, 0.5, 1) - t).abs() < 1e-6);
+        assert!(turbulence(p, Vec3::ZERO, Vec3::ZERO, 0.5, 8) > 0.0);
     }
 }

@@ -51,22 +51,23 @@ const MARBLE: [[f32; 3]; 9] = [
 ];
 
 impl NoisePattern {
-    /// The scalar value of a grey pattern (all but marble).
-    pub fn scalar(&self, p: Vec3) -> f32 {
+    /// The scalar value of a grey pattern (all but marble) at texture-space point `p` whose
+    /// footprint is `dpdx`, `dpdy` (zero: none, every octave).
+    pub fn scalar(&self, p: Vec3, dpdx: Vec3, dpdy: Vec3) -> f32 {
         match *self {
-            NoisePattern::Fbm { omega, octaves } => fbm(p, omega, octaves),
-            NoisePattern::Wrinkled { omega, octaves } => turbulence(p, omega, octaves),
+            NoisePattern::Fbm { omega, octaves } => fbm(p, dpdx, dpdy, omega, octaves),
+            NoisePattern::Wrinkled { omega, octaves } => turbulence(p, dpdx, dpdy, omega, octaves),
             NoisePattern::Windy => {
-                let wind = fbm(0.1 * p, 0.5, 3);
-                let wave = fbm(p, 0.5, 6);
+                let wind = fbm(0.1 * p, 0.1 * dpdx, 0.1 * dpdy, 0.5, 3);
+                let wave = fbm(p, dpdx, dpdy, 0.5, 6);
                 wind.abs() * wave
             }
-            NoisePattern::Marble { .. } => self.colour(p).x,
+            NoisePattern::Marble { .. } => self.colour(p, dpdx, dpdy).x,
         }
     }
 
     /// The pattern's colour: marble's spline, or the scalar in every channel.
-    pub fn colour(&self, p: Vec3) -> Spectrum {
+    pub fn colour(&self, p: Vec3, dpdx: Vec3, dpdy: Vec3) -> Spectrum {
         let NoisePattern::Marble {
             omega,
             octaves,
@@ -74,10 +75,10 @@ impl NoisePattern {
             variation,
         } = *self
         else {
-            return Spectrum::splat(self.scalar(p));
+            return Spectrum::splat(self.scalar(p, dpdx, dpdy));
         };
         let p = p * scale;
-        let marble = p.y + variation * fbm(p, omega, octaves);
+        let marble = p.y + variation * fbm(p, scale * dpdx, scale * dpdy, omega, octaves);
         let t = 0.5 + 0.5 * marble.sin();
         let segments = (MARBLE.len() - 3) as f32;
         // pbrt-v3 writes `std::min(1, int(std::floor(t * NSEG)))` (its own slip for
@@ -127,15 +128,28 @@ mod tests {
             omega: 0.5,
             octaves: 8,
         };
-        assert_eq!(f.scalar(p), fbm(p, 0.5, 8));
-        assert_eq!(f.colour(p), Spectrum::splat(fbm(p, 0.5, 8)));
+        assert_eq!(
+            f.scalar(p, Vec3::ZERO, Vec3::ZERO),
+            fbm(p, Vec3::ZERO, Vec3::ZERO, 0.5, 8)
+        );
+        assert_eq!(
+            f.colour(p, Vec3::ZERO, Vec3::ZERO),
+            Spectrum::splat(fbm(p, Vec3::ZERO, Vec3::ZERO, 0.5, 8))
+        );
         let w = NoisePattern::Wrinkled {
             omega: 0.7,
             octaves: 3,
         };
-        assert_eq!(w.scalar(p), turbulence(p, 0.7, 3));
-        let windy = NoisePattern::Windy.scalar(p);
-        assert_eq!(windy, fbm(0.1 * p, 0.5, 3).abs() * fbm(p, 0.5, 6));
+        assert_eq!(
+            w.scalar(p, Vec3::ZERO, Vec3::ZERO),
+            turbulence(p, Vec3::ZERO, Vec3::ZERO, 0.7, 3)
+        );
+        let windy = NoisePattern::Windy.scalar(p, Vec3::ZERO, Vec3::ZERO);
+        assert_eq!(
+            windy,
+            fbm(0.1 * p, Vec3::ZERO, Vec3::ZERO, 0.5, 3).abs()
+                * fbm(p, Vec3::ZERO, Vec3::ZERO, 0.5, 6)
+        );
     }
 
     #[test]
@@ -189,15 +203,21 @@ mod tests {
         };
         for (p, rgb, windy, wr) in cases {
             let p = Vec3::from_array(p);
-            let m = marble.colour(p).to_array();
+            let m = marble.colour(p, Vec3::ZERO, Vec3::ZERO).to_array();
             for (g, w) in m.iter().zip(rgb) {
                 assert!(
                     (g - w).abs() <= 2e-6 * w.abs().max(1.0),
                     "{p}: {m:?} against {rgb:?}"
                 );
             }
-            assert!((NoisePattern::Windy.scalar(p) - windy).abs() < 2e-6, "{p}");
-            assert!((wrinkled.scalar(p) - wr).abs() < 2e-6, "{p}");
+            assert!(
+                (NoisePattern::Windy.scalar(p, Vec3::ZERO, Vec3::ZERO) - windy).abs() < 2e-6,
+                "{p}"
+            );
+            assert!(
+                (wrinkled.scalar(p, Vec3::ZERO, Vec3::ZERO) - wr).abs() < 2e-6,
+                "{p}"
+            );
         }
     }
 

@@ -3,8 +3,8 @@
 
 use crate::camera::CameraSample;
 use crate::features::{FeatureImage, FirstHit};
-use crate::geometry::Ray;
 use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
+use crate::geometry::{Ray, RayDifferentials};
 use crate::integrator::{Integrator, Radiance};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
@@ -199,7 +199,10 @@ pub fn render_with_features(
     progress: Option<&indicatif::ProgressBar>,
     features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
-    let li = |scene: &Scene, ray: Ray, stream: &mut SampleStream| integrator.li(scene, ray, stream);
+    let li = |scene: &Scene,
+              ray: Ray,
+              diff: Option<&RayDifferentials>,
+              stream: &mut SampleStream| { integrator.li(scene, ray, diff, stream) };
     render_with(scene, &li, sampler, film, seed, stop, progress, features)
 }
 
@@ -280,7 +283,9 @@ fn timed<T>(total: &mut Duration, f: impl FnOnce() -> T) -> T {
 }
 
 /// What a sample estimates: the radiance arriving along a camera ray.
-pub type Estimator<'a> = dyn Fn(&Scene, Ray, &mut SampleStream) -> Radiance + Sync + 'a;
+/// The ray comes with its differentials, scaled to the sample spacing.
+pub type Estimator<'a> =
+    dyn Fn(&Scene, Ray, Option<&RayDifferentials>, &mut SampleStream) -> Radiance + Sync + 'a;
 
 /// One traced sample: its radiance, rays and first-hit features.
 type SampleResult = (Spectrum, u32, FirstHit);
@@ -314,6 +319,9 @@ pub fn render_with(
     // sharing one, a sample and its neighbour in the other stream would be a stratified pair,
     // and one stream's values would tell where the other's went.
     let streams = sampler.streams().max(1);
+    // pbrt-v3 scales the differentials to the spacing of a pixel's samples: 1 / sqrt(spp), of
+    // the scene's own budget (see `Scene::differential_scale`).
+    let diff_scale = scene.differential_scale;
     let trace = |batch: &[SamplePoint], results: &mut Vec<SampleResult>| {
         batch
             .par_iter()
@@ -326,12 +334,13 @@ pub fn render_with(
                 // The integrator's decisions come after the dims the sampler drew.
                 let mut stream =
                     SampleStream::new(key, q.index / streams, own.seed(seed), SOBOL_DIMS_USED);
-                let ray = scene.camera.generate_ray(&CameraSample {
+                let (ray, diff) = scene.camera.generate_ray_differential(&CameraSample {
                     film: Vec2::from(q.film),
                     lens: Vec2::from(q.lens),
                     time: q.time,
                 });
-                let r = li(scene, ray, &mut stream);
+                let diff = diff.scaled(&ray, diff_scale);
+                let r = li(scene, ray, Some(&diff), &mut stream);
                 (r.l, r.rays, r.first_hit)
             })
             .collect_into_vec(results);

@@ -8,17 +8,15 @@
 //! each texture description is built once and shared, and each image file is read once.
 //! Evaluation allocates nothing.
 //!
-//! Differences from pbrt-v3, which has ray differentials and acr has not:
-//! - image maps are looked up bilinearly in the full-resolution image, where pbrt-v3 filters a
-//!   MIP map (EWA by default, trilinear on request) over the ray's footprint, after resampling
-//!   images whose sides are not powers of two; `trilinear` and `maxanisotropy` are accepted and
-//!   ignored. Minified textures therefore alias where pbrt-v3 blurs.
-//! - the checkerboard is evaluated at the hit point (pbrt-v3's `aamode "none"`); pbrt-v3's
-//!   default `"closedform"` box-filters over the footprint, which only differs where a check
-//!   edge falls inside the footprint.
+//! Camera-ray hits carry their footprint (the ray differentials, `SurfaceInteraction::diff`):
+//! the mappings turn it into (s, t) derivatives as pbrt-v3's do, image maps filter their MIP
+//! map over it (`crate::mipmap`: EWA by default, trilinear on request), the 2D checkerboard
+//! box-filters over it (pbrt-v3's default `aamode "closedform"`), and the noise textures stop
+//! their octaves at it.
 
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
 use crate::image_io::{read_image, RgbImage};
+use crate::mipmap::MipMap;
 use crate::procedural::{in_dot, NoisePattern};
 use crate::spectrum::{is_spectrum_type, luminance, spectrum_param_to_rgb, srgb_to_linear};
 use acr_parser::{
@@ -55,6 +53,8 @@ pub trait TexValue:
     /// A texel of an image file as pbrt-v3's image texture stores it: sRGB-decoded when `gamma`
     /// (for floats, the luminance is decoded), times `scale`; with `invert`, 1 - v, at least 0.
     fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self;
+    /// The value with negative parts set to 0.
+    fn clamp_nonneg(self) -> Self;
 }
 
 impl TexValue for f32 {
@@ -63,6 +63,10 @@ impl TexValue for f32 {
 
     fn from_uv(s: f32, _t: f32) -> Self {
         s - s.floor()
+    }
+
+    fn clamp_nonneg(self) -> Self {
+        self.max(0.0)
     }
 
     fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self {
@@ -82,6 +86,10 @@ impl TexValue for Spectrum {
 
     fn from_uv(s: f32, t: f32) -> Self {
         Spectrum::new(s - s.floor(), t - t.floor(), 0.0)
+    }
+
+    fn clamp_nonneg(self) -> Self {
+        self.max(Spectrum::ZERO)
     }
 
     fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self {
@@ -198,6 +206,46 @@ impl Mapping2D {
         })
     }
 
+    /// Texture coordinates of the hit and their screen-space derivatives (pbrt-v3's
+    /// `TextureMapping2D::Map`: the spherical and cylindrical mappings difference the point
+    /// moved along dp/dx and dp/dy, and fold their azimuth's wrap-around as pbrt-v3 does).
+    pub fn map_differentials(&self, si: &SurfaceInteraction) -> (Vec2, Vec2, Vec2) {
+        let st = self.map(si);
+        let d = &si.diff;
+        let (dstdx, dstdy) = match *self {
+            Mapping2D::Uv { su, sv, .. } => (
+                Vec2::new(su * d.dudx, sv * d.dvdx),
+                Vec2::new(su * d.dudy, sv * d.dvdy),
+            ),
+            Mapping2D::Spherical { .. } | Mapping2D::Cylindrical { .. } => {
+                let delta = if matches!(self, Mapping2D::Spherical { .. }) {
+                    0.1
+                } else {
+                    0.01
+                };
+                let shifted = |dp: Vec3| {
+                    let moved = SurfaceInteraction {
+                        p: si.p + delta * dp,
+                        ..*si
+                    };
+                    let mut ds = (self.map(&moved) - st) / delta;
+                    if ds.y > 0.5 {
+                        ds.y = 1.0 - ds.y;
+                    } else if ds.y < -0.5 {
+                        ds.y = -(ds.y + 1.0);
+                    }
+                    ds
+                };
+                (shifted(d.dpdx), shifted(d.dpdy))
+            }
+            Mapping2D::Planar { vs, vt, .. } => (
+                Vec2::new(d.dpdx.dot(vs), d.dpdx.dot(vt)),
+                Vec2::new(d.dpdy.dot(vs), d.dpdy.dot(vt)),
+            ),
+        };
+        (st, dstdx, dstdy)
+    }
+
     /// Texture coordinates of the hit.
     #[inline]
     pub fn map(&self, si: &SurfaceInteraction) -> Vec2 {
@@ -290,6 +338,11 @@ impl<T: TexValue> ImageMap<T> {
         }
     }
 
+    /// What a lookup outside [0, 1]² gives.
+    pub fn wrap(&self) -> Wrap {
+        self.wrap
+    }
+
     /// The texels, row 0 first.
     pub fn texels(&self) -> &[T] {
         &self.texels
@@ -375,6 +428,9 @@ pub enum Texture<T> {
         tex1: Arc<Texture<T>>,
         /// Odd checks.
         tex2: Arc<Texture<T>>,
+        /// Box-filtered over the hit's footprint (pbrt-v3's `aamode "closedform"`, its
+        /// default), else point-sampled (`"none"`).
+        closed_form: bool,
     },
     /// `tex1` where ⌊x⌋ + ⌊y⌋ + ⌊z⌋ of the texture-space point is even, else `tex2`.
     Checkerboard3D {
@@ -385,12 +441,12 @@ pub enum Texture<T> {
         /// Odd cells.
         tex2: Arc<Texture<T>>,
     },
-    /// An image, looked up bilinearly.
+    /// An image, filtered over the hit's footprint (pbrt-v3's MIP map).
     Image {
         /// Texture coordinates.
         mapping: Mapping2D,
-        /// The converted texels.
-        image: Arc<ImageMap<T>>,
+        /// The converted texels' pyramid.
+        image: Arc<MipMap<T>>,
     },
     /// Bilinear interpolation of four corner values over (s, t).
     Bilerp {
@@ -442,14 +498,43 @@ impl<T: TexValue> Texture<T> {
                 mapping,
                 tex1,
                 tex2,
+                closed_form,
             } => {
-                let st = mapping.map(si);
-                let sum = (st.x.floor() as i64).wrapping_add(st.y.floor() as i64);
-                if sum % 2 == 0 {
-                    tex1.eval(si)
-                } else {
-                    tex2.eval(si)
+                let (st, dstdx, dstdy) = mapping.map_differentials(si);
+                let point = || {
+                    let sum = (st.x.floor() as i64).wrapping_add(st.y.floor() as i64);
+                    if sum % 2 == 0 {
+                        tex1.eval(si)
+                    } else {
+                        tex2.eval(si)
+                    }
+                };
+                if !closed_form {
+                    return point();
                 }
+                // pbrt-v3's closed-form box filter over the footprint.
+                let ds = dstdx.x.abs().max(dstdy.x.abs());
+                let dt = dstdx.y.abs().max(dstdy.y.abs());
+                let (s0, s1, t0, t1) = (st.x - ds, st.x + ds, st.y - dt, st.y + dt);
+                if s0.floor() == s1.floor() && t0.floor() == t1.floor() {
+                    return point();
+                }
+                let bump_int = |x: f32| {
+                    let h = (x / 2.0).floor();
+                    h + 2.0 * (x / 2.0 - h - 0.5).max(0.0)
+                };
+                let sint = (bump_int(s1) - bump_int(s0)) / (2.0 * ds);
+                let tint = (bump_int(t1) - bump_int(t0)) / (2.0 * dt);
+                let mut area2 = sint + tint - 2.0 * sint * tint;
+                // A footprint wider than a check: its mean, as pbrt-v3.
+                if ds > 1.0 || dt > 1.0 {
+                    area2 = 0.5;
+                }
+                // A footprint with no width in s or t (0 / 0): the point value.
+                if area2.is_nan() {
+                    return point();
+                }
+                tex1.eval(si) * (1.0 - area2) + tex2.eval(si) * area2
             }
             Texture::Checkerboard3D {
                 texture_from_world,
@@ -466,7 +551,10 @@ impl<T: TexValue> Texture<T> {
                     tex2.eval(si)
                 }
             }
-            Texture::Image { mapping, image } => image.bilerp(mapping.map(si)),
+            Texture::Image { mapping, image } => {
+                let (st, dstdx, dstdy) = mapping.map_differentials(si);
+                image.lookup(st, dstdx, dstdy)
+            }
             Texture::Bilerp { mapping, v } => {
                 let st = mapping.map(si);
                 let (s, t) = (st.x, st.y);
@@ -484,12 +572,14 @@ impl<T: TexValue> Texture<T> {
                 pattern,
             } => {
                 let p = texture_from_render.project_point3(si.p);
+                let dpdx = texture_from_render.transform_vector3(si.diff.dpdx);
+                let dpdy = texture_from_render.transform_vector3(si.diff.dpdy);
                 match pattern {
                     // Built for spectrum textures only.
                     NoisePattern::Marble { .. } => {
-                        T::from_texel(pattern.colour(p), 1.0, false, false)
+                        T::from_texel(pattern.colour(p, dpdx, dpdy), 1.0, false, false)
                     }
-                    _ => T::ONE * pattern.scalar(p),
+                    _ => T::ONE * pattern.scalar(p, dpdx, dpdy),
                 }
             }
             Texture::Dots {
@@ -630,7 +720,7 @@ fn noise_pattern(kind: &str, p: &ParamList) -> Result<NoisePattern> {
     })
 }
 
-/// What identifies a converted image map (pbrt-v3's `TexInfo`, less the filtering options).
+/// What identifies a converted image map and its MIP map (pbrt-v3's `TexInfo`).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct ImageKey {
     path: PathBuf,
@@ -638,6 +728,8 @@ struct ImageKey {
     scale: u32,
     invert: bool,
     wrap: Wrap,
+    trilinear: bool,
+    max_anisotropy: u32,
 }
 
 /// Builds textures on demand from a scene description's texture definitions, each at most once,
@@ -648,8 +740,8 @@ pub struct TextureBuilder<'a> {
     floats: Vec<Option<Arc<FloatTexture>>>,
     spectra: Vec<Option<Arc<SpectrumTexture>>>,
     files: HashMap<PathBuf, Arc<RgbImage>>,
-    float_maps: HashMap<ImageKey, Arc<ImageMap<f32>>>,
-    spectrum_maps: HashMap<ImageKey, Arc<ImageMap<Spectrum>>>,
+    float_maps: HashMap<ImageKey, Arc<MipMap<f32>>>,
+    spectrum_maps: HashMap<ImageKey, Arc<MipMap<Spectrum>>>,
     warned: HashSet<String>,
     warnings: Vec<Warning>,
     /// Render space from world space (see [`crate::scene::Scene::render_from_world`]).
@@ -659,7 +751,7 @@ pub struct TextureBuilder<'a> {
 /// Per-value-type access to the builder's caches and parameter lookups.
 trait Build: TexValue {
     fn cache<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut Vec<Option<Arc<Texture<Self>>>>;
-    fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<ImageMap<Self>>>;
+    fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<MipMap<Self>>>;
     fn param(
         b: &mut TextureBuilder<'_>,
         params: &ParamList,
@@ -672,7 +764,7 @@ impl Build for f32 {
     fn cache<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut Vec<Option<Arc<Texture<Self>>>> {
         &mut b.floats
     }
-    fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<ImageMap<Self>>> {
+    fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<MipMap<Self>>> {
         &mut b.float_maps
     }
     fn param(
@@ -691,7 +783,7 @@ impl Build for Spectrum {
     fn cache<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut Vec<Option<Arc<Texture<Self>>>> {
         &mut b.spectra
     }
-    fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<ImageMap<Self>>> {
+    fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<MipMap<Self>>> {
         &mut b.spectrum_maps
     }
     fn param(
@@ -933,8 +1025,9 @@ impl<'a> TextureBuilder<'a> {
                             &(self.render_from_world * td.world_from_texture),
                             loc,
                         )?;
-                        match p.string("aamode")? {
-                            None | Some("none") | Some("closedform") => {}
+                        let closed_form = match p.string("aamode")? {
+                            Some("none") => false,
+                            None | Some("closedform") => true,
                             Some(other) => {
                                 let at = p.get("aamode").map_or(loc, |x| &x.loc);
                                 self.warn_once(
@@ -942,15 +1035,18 @@ impl<'a> TextureBuilder<'a> {
                                     at,
                                     format!(
                                         "checkerboard antialiasing mode \"{other}\" is unknown \
-                                         (none or closedform)"
+                                         (none or closedform); closedform is used, as pbrt-v3 \
+                                         does"
                                     ),
                                 );
+                                true
                             }
-                        }
+                        };
                         Texture::Checkerboard2D {
                             mapping,
                             tex1,
                             tex2,
+                            closed_form,
                         }
                     }
                     3 => Texture::Checkerboard3D {
@@ -1057,8 +1153,9 @@ impl<'a> TextureBuilder<'a> {
         Ok(tex)
     }
 
-    /// The image map an `imagemap` texture's parameters describe, read and converted once.
-    fn image_map<T: Build>(&mut self, p: &ParamList, loc: &Loc) -> Result<Arc<ImageMap<T>>> {
+    /// The MIP map an `imagemap` texture's parameters describe, read, converted and built
+    /// once.
+    fn image_map<T: Build>(&mut self, p: &ParamList, loc: &Loc) -> Result<Arc<MipMap<T>>> {
         let Some(name) = p.string("filename")? else {
             return Err(Error::at(loc, "imagemap texture needs \"string filename\""));
         };
@@ -1088,9 +1185,8 @@ impl<'a> TextureBuilder<'a> {
                 Wrap::Repeat
             }
         };
-        // Accepted for pbrt-v3 compatibility; acr has no MIP map to filter.
-        let _ = p.bool("trilinear")?;
-        let _ = p.float("maxanisotropy")?;
+        let trilinear = p.bool_or("trilinear", false)?;
+        let max_anisotropy = p.float_or("maxanisotropy", 8.0)? as f32;
 
         let key_path = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
         let key = ImageKey {
@@ -1099,6 +1195,8 @@ impl<'a> TextureBuilder<'a> {
             scale: scale.to_bits(),
             invert,
             wrap,
+            trilinear,
+            max_anisotropy: max_anisotropy.to_bits(),
         };
         if let Some(m) = T::maps(self).get(&key) {
             return Ok(Arc::clone(m));
@@ -1117,9 +1215,8 @@ impl<'a> TextureBuilder<'a> {
                 img
             }
         };
-        let map = Arc::new(ImageMap::new(&img, wrap, |c| {
-            T::from_texel(c, scale, gamma, invert)
-        }));
+        let map = ImageMap::new(&img, wrap, |c| T::from_texel(c, scale, gamma, invert));
+        let map = Arc::new(MipMap::new(&map, trilinear, max_anisotropy));
         T::maps(self).insert(key, Arc::clone(&map));
         Ok(map)
     }
@@ -1451,7 +1548,10 @@ mod tests {
         let mut b = TextureBuilder::new(&desc, Path::new("/tmp"));
         let f = b.float_texture(0).unwrap();
         let p = Vec3::new(0.3, 1.7, -2.2);
-        assert_eq!(f.eval(&si_p(p)), crate::noise::fbm(p, 0.7, 3));
+        assert_eq!(
+            f.eval(&si_p(p)),
+            crate::noise::fbm(p, Vec3::ZERO, Vec3::ZERO, 0.7, 3)
+        );
         let e = b.float_texture(1).unwrap_err();
         assert!(e.message().contains("spectrum texture"), "{e}");
         let e = b.float_texture(2).unwrap_err();

@@ -346,6 +346,7 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("disney.pbrt", "disney", 16),
     ("hair.pbrt", "hair", 16),
     ("fourier.pbrt", "fourier", 16),
+    ("texture-filtering.pbrt", "texture-filtering", 4),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

@@ -196,9 +196,12 @@ fn an_estimator_returning_nan_for_half_its_samples_leaves_a_finite_image_and_cou
     let mut film = plugins.film(&scene);
     let integrator = &plugins.integrator;
     // The decision comes from the sample's own random stream, so it is the same for a seed.
-    let li = |s: &Scene, ray, stream: &mut acr::stream::SampleStream| {
+    let li = |s: &Scene,
+              ray,
+              diff: Option<&acr::geometry::RayDifferentials>,
+              stream: &mut acr::stream::SampleStream| {
         let nan = stream.next_1d() < 0.5;
-        let mut r = integrator.li(s, ray, stream);
+        let mut r = integrator.li(s, ray, diff, stream);
         if nan {
             r.l = Spectrum::splat(f32::NAN);
         }

@@ -344,6 +344,7 @@ fn unreachable_interaction(ray: &Ray, t: f32) -> SurfaceInteraction {
         wo: n,
         time: ray.time,
         p_error: 0.0,
+        diff: Default::default(),
     }
 }
 
@@ -577,6 +578,7 @@ fn transform_interaction(
                 .length()
                 .max(to_world.y_axis.truncate().length())
                 .max(to_world.z_axis.truncate().length()),
+        diff: si.diff,
     }
 }
 

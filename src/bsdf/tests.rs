@@ -408,6 +408,7 @@ fn world_frame_follows_the_shading_tangent() {
         wo: Vec3::Y,
         time: 0.0,
         p_error: 0.0,
+        diff: Default::default(),
     };
     let b = Bsdf::new(&si, 1.0);
     assert!((b.frame().n - Vec3::Y).length() < 1e-6);

@@ -290,6 +290,7 @@ fn curve_hit(v: f32) -> SurfaceInteraction {
         wo: Vec3::Z,
         time: 0.0,
         p_error: 0.0,
+        diff: Default::default(),
     }
 }
 

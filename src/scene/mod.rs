@@ -64,6 +64,34 @@ pub struct Scene {
     /// origin (pbrt-v4's "camera-world" space). f32 resolution is finest near the origin, so a
     /// scene far from the world origin renders as precisely as one at it.
     pub render_from_world: DMat4,
+    /// How much the camera rays' differentials are scaled (pbrt-v3's 1 / sqrt(samples per
+    /// pixel)), from the scene's own Sampler budget, not `--spp`: a pixel's samples then do
+    /// not depend on how many are taken, so that renders at any spp converge to one image and
+    /// sample ranges merge exactly.
+    pub differential_scale: f32,
+}
+
+/// pbrt-v3's samples per pixel for the scene's Sampler, as its ray differentials are scaled
+/// by them: `xsamples` x `ysamples` for stratified (4 x 4), `pixelsamples` (16) for the
+/// others, rounded up to a power of two where pbrt-v3's sampler does (02sequence,
+/// lowdiscrepancy, sobol, maxmindist). Bad values count as the defaults here: the sampler's
+/// own construction reports them.
+fn sampler_spp(desc: &SceneDescription) -> u32 {
+    let Some(s) = &desc.sampler else {
+        return 16;
+    };
+    let p = &s.params;
+    let int = |name: &str, default: i32| -> u64 {
+        p.int_or(name, default).unwrap_or(default).clamp(1, 1 << 20) as u64
+    };
+    let spp = match s.kind.as_str() {
+        "stratified" => int("xsamples", 4) * int("ysamples", 4),
+        "02sequence" | "lowdiscrepancy" | "sobol" | "maxmindist" => {
+            int("pixelsamples", 16).next_power_of_two()
+        }
+        _ => int("pixelsamples", 16),
+    };
+    spp.clamp(1, 1 << 40) as u32
 }
 
 /// A ray's closest hit, resolved.
@@ -402,6 +430,7 @@ impl Scene {
             world_center,
             world_radius,
             render_from_world,
+            differential_scale: 1.0 / (sampler_spp(desc) as f32).sqrt(),
         })
     }
 }

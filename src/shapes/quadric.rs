@@ -109,6 +109,7 @@ pub(crate) fn quadric_interaction(
         wo: (-ray.d).normalize_or_zero(),
         time: ray.time,
         p_error: 0.0,
+        diff: Default::default(),
     }
 }
 

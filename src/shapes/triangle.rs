@@ -405,6 +405,7 @@ pub fn triangle_interaction(
         wo: (-ray.d).normalize_or_zero(),
         time: ray.time,
         p_error: 0.0,
+        diff: Default::default(),
     }
 }
 
