@@ -55,6 +55,31 @@ fn resample_weights(old: usize, new: usize) -> Vec<(i64, [f32; 4])> {
         .collect()
 }
 
+/// `lines` lines of `old` texels each (texel i of line l is `at(l, i)`) resampled to `new`
+/// texels with pbrt-v3's weights, line after line.
+fn resample_lines<T: TexValue>(
+    at: impl Fn(usize, usize) -> T,
+    lines: usize,
+    old: usize,
+    new: usize,
+    wrap: Wrap,
+) -> Vec<T> {
+    let weights = resample_weights(old, new);
+    let mut out = Vec::with_capacity(lines * new);
+    for l in 0..lines {
+        for (first, w) in &weights {
+            let mut v = T::ZERO;
+            for (j, &wt) in w.iter().enumerate() {
+                if let Some(o) = wrap_index(first + j as i64, old, wrap) {
+                    v = v + at(l, o) * wt;
+                }
+            }
+            out.push(v);
+        }
+    }
+    out
+}
+
 /// Where texel `i` of a `size`-texel row lies after wrapping (`None`: black, outside).
 fn wrap_index(i: i64, size: usize, wrap: Wrap) -> Option<usize> {
     let n = size as i64;
@@ -87,32 +112,13 @@ impl<T: TexValue> MipMap<T> {
         } else {
             let (w2, h2) = (w.next_power_of_two(), h.next_power_of_two());
             let texels = image.texels();
-            // Along s, row by row.
-            let sw = resample_weights(w, w2);
-            let mut wide = vec![T::ZERO; w2 * h];
-            for t in 0..h {
-                for (s, (first, weights)) in sw.iter().enumerate() {
-                    let mut v = T::ZERO;
-                    for (j, &wt) in weights.iter().enumerate() {
-                        if let Some(o) = wrap_index(first + j as i64, w, wrap) {
-                            v = v + texels[t * w + o] * wt;
-                        }
-                    }
-                    wide[t * w2 + s] = v;
-                }
-            }
-            // Along t, column by column, clamped.
-            let tw = resample_weights(h, h2);
+            // Along s, row by row; then along t, column by column, clamped.
+            let wide = resample_lines(|t, s| texels[t * w + s], h, w, w2, wrap);
+            let tall = resample_lines(|s, t| wide[t * w2 + s], w2, h, h2, wrap);
             let mut out = vec![T::ZERO; w2 * h2];
             for s in 0..w2 {
-                for (t, (first, weights)) in tw.iter().enumerate() {
-                    let mut v = T::ZERO;
-                    for (j, &wt) in weights.iter().enumerate() {
-                        if let Some(o) = wrap_index(first + j as i64, h, wrap) {
-                            v = v + wide[o * w2 + s] * wt;
-                        }
-                    }
-                    out[t * w2 + s] = v.clamp_nonneg();
+                for t in 0..h2 {
+                    out[t * w2 + s] = tall[s * h2 + t].clamp_nonneg();
                 }
             }
             ImageMap::from_rows(w2, h2, out, wrap)

@@ -53,6 +53,15 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// The largest difference between two images' channels, relative to the second's (at least
+/// 1e-3).
+fn worst_relative(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / y[c].abs().max(1e-3)))
+        .fold(0.0f32, f32::max)
+}
+
 /// For every non-adaptive sampler and every splatting filter, three uneven crops of a 240x160
 /// frame, merged, equal the whole-frame render exactly: the crops sample the pixels within the
 /// filter's radius around them (pbrt-v3's sample bounds), and each pixel's sample streams are
@@ -334,12 +343,7 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
                 merged.counts.iter().all(|&c| c == 16.0),
                 "{sampler} + {filter}"
             );
-            let worst = merged
-                .image()
-                .iter()
-                .zip(whole.image())
-                .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / y[c].abs().max(1e-3)))
-                .fold(0.0f32, f32::max);
+            let worst = worst_relative(&merged.image(), &whole.image());
             eprintln!("{sampler} + {filter}: largest relative difference {worst:.1e}");
             assert!(
                 worst < 1e-5,
@@ -348,11 +352,7 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
             // The variance moments add up too: the merge's per-pixel sample variance is the
             // whole render's.
             let (mv, wv) = (merged.variance().unwrap(), whole.variance().unwrap());
-            let worst_var = mv
-                .iter()
-                .zip(&wv)
-                .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / y[c].abs().max(1e-3)))
-                .fold(0.0f32, f32::max);
+            let worst_var = worst_relative(&mv, &wv);
             assert!(
                 worst_var < 1e-4,
                 "{sampler} + {filter}: variance {worst_var}"
@@ -485,12 +485,7 @@ fn a_stopped_render_resumes_by_rendering_the_rest_and_merging() {
         Sums::read(&full).unwrap().unwrap(),
     );
     assert_eq!((m.spp, m.offset), (SPP, Some(0)));
-    let worst = m
-        .image()
-        .iter()
-        .zip(f.image())
-        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / y[c].abs().max(1e-3)))
-        .fold(0.0f32, f32::max);
+    let worst = worst_relative(&m.image(), &f.image());
     eprintln!("stopped at {k} of {SPP} spp; resumed: largest relative difference {worst:.1e}");
     assert!(worst < 1e-5, "{worst}");
     let _ = std::fs::remove_dir_all(&dir);

@@ -1,7 +1,10 @@
 //! Tests of the BSDFs: lobes, frames, sampling against evaluation.
 
+use super::bxdf::ONE_MINUS_EPSILON;
 use super::check::*;
 use super::*;
+use crate::microfacet::TrowbridgeReitz;
+use std::f32::consts::FRAC_1_PI;
 
 fn local_bsdf(bxdfs: &[Bxdf], eta: f32) -> Bsdf {
     let mut b = Bsdf::from_frame(Frame::from_z(Vec3::Z), Vec3::Z, eta);
