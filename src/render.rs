@@ -334,13 +334,18 @@ pub fn render_with(
                 // The integrator's decisions come after the dims the sampler drew.
                 let mut stream =
                     SampleStream::new(key, q.index / streams, own.seed(seed), SOBOL_DIMS_USED);
-                let (ray, diff) = scene.camera.generate_ray_differential(&CameraSample {
+                let sample = CameraSample {
                     film: Vec2::from(q.film),
                     lens: Vec2::from(q.lens),
                     time: q.time,
-                });
-                let diff = diff.scaled(&ray, diff_scale);
-                let r = li(scene, ray, Some(&diff), &mut stream);
+                };
+                let r = if scene.uses_differentials {
+                    let (ray, diff) = scene.camera.generate_ray_differential(&sample);
+                    let diff = diff.scaled(&ray, diff_scale);
+                    li(scene, ray, Some(&diff), &mut stream)
+                } else {
+                    li(scene, scene.camera.generate_ray(&sample), None, &mut stream)
+                };
                 (r.l, r.rays, r.first_hit)
             })
             .collect_into_vec(results);

@@ -69,6 +69,29 @@ pub struct Scene {
     /// not depend on how many are taken, so that renders at any spp converge to one image and
     /// sample ranges merge exactly.
     pub differential_scale: f32,
+    /// Whether anything looks at a hit's footprint (image maps, checkerboards, noise textures,
+    /// bump maps): when nothing does, camera rays go without differentials (two camera rays
+    /// fewer per sample; the image is the same).
+    pub uses_differentials: bool,
+}
+
+/// Whether the scene has a texture class or a bump map that reads the ray differentials.
+fn uses_differentials(desc: &SceneDescription) -> bool {
+    let footprint = [
+        "imagemap",
+        "checkerboard",
+        "fbm",
+        "wrinkled",
+        "windy",
+        "marble",
+    ];
+    desc.textures
+        .iter()
+        .any(|t| footprint.contains(&t.plugin.kind.as_str()))
+        || desc
+            .materials
+            .iter()
+            .any(|m| m.plugin.params.iter().any(|p| p.name == "bumpmap"))
 }
 
 /// pbrt-v3's samples per pixel for the scene's Sampler, as its ray differentials are scaled
@@ -431,6 +454,7 @@ impl Scene {
             world_radius,
             render_from_world,
             differential_scale: 1.0 / (sampler_spp(desc) as f32).sqrt(),
+            uses_differentials: uses_differentials(desc),
         })
     }
 }
