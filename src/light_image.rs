@@ -14,6 +14,7 @@
 use crate::geometry::{Spectrum, Vec2, Vec3};
 use crate::image_io::RgbImage;
 use crate::light::{Light, LightSample};
+use crate::mipmap::MipMap;
 use crate::texture::{ImageMap, Wrap};
 use glam::{DMat4, Mat4};
 use std::f32::consts::PI;
@@ -30,9 +31,12 @@ const HITHER: f32 = 1e-3;
 #[derive(Clone, Debug)]
 pub struct LightImage {
     /// Top row first, as read (pbrt-v3's MIP map keeps the file's order), wrapped around on
-    /// both axes (pbrt-v3's `ImageWrap::Repeat`).
+    /// both axes (pbrt-v3's `ImageWrap::Repeat`): the image as read.
     map: ImageMap<Spectrum>,
-    /// The mean of the pixels (what pbrt-v3's `Power` looks up, see [`LightImage::average`]).
+    /// Its MIP map (resampled to powers of two, as pbrt-v3's lights build one), which lookups
+    /// read.
+    mip: MipMap<Spectrum>,
+    /// What pbrt-v3's `Power` looks up, see [`LightImage::average`].
     average: Spectrum,
 }
 
@@ -44,22 +48,11 @@ impl LightImage {
         if width == 0 || height == 0 || img.pixels.len() != width * height {
             return None;
         }
-        let sum = img.pixels.iter().fold([0f64; 3], |s, p| {
-            [
-                s[0] + f64::from(p.x),
-                s[1] + f64::from(p.y),
-                s[2] + f64::from(p.z),
-            ]
-        });
-        let n = (width * height) as f64;
-        Some(Self {
-            map: ImageMap::from_rows(width, height, img.pixels.clone(), Wrap::Repeat),
-            average: Spectrum::new(
-                (sum[0] / n) as f32,
-                (sum[1] / n) as f32,
-                (sum[2] / n) as f32,
-            ),
-        })
+        let map = ImageMap::from_rows(width, height, img.pixels.clone(), Wrap::Repeat);
+        let mip = MipMap::new(&map, false, 8.0);
+        // pbrt-v3's Power: a trilinear lookup at the centre with width 0.5.
+        let average = mip.lookup_width(Vec2::splat(0.5), 0.5);
+        Some(Self { map, mip, average })
     }
 
     /// Width in pixels.
@@ -72,9 +65,9 @@ impl LightImage {
         self.map.height()
     }
 
-    /// The mean pixel. pbrt-v3's `Power` looks its MIP map up at (0.5, 0.5) with width 0.5,
-    /// which lands on the 2x2 (or 2x1) level, box-filtered from the image, at its centre:
-    /// the mean of the whole image (for sides that are powers of two).
+    /// The mean pixel, as pbrt-v3's `Power` takes it: its MIP map looked up at (0.5, 0.5) with
+    /// width 0.5, which lands on the 2x2 (or 2x1) level at its centre, the mean of the image
+    /// (resampled to powers of two).
     pub fn average(&self) -> Spectrum {
         self.average
     }
@@ -91,10 +84,11 @@ impl LightImage {
     }
 
     /// Bilinear interpolation at `st` in [0, 1]², t = 0 at the top row: pbrt-v3's
-    /// `MIPMap::Lookup(st)` with no filter width, its bilinear `triangle` at level 0.
+    /// `MIPMap::Lookup(st)` with no filter width, its bilinear `triangle` at level 0 (of the
+    /// image resampled to powers of two).
     #[inline]
     pub fn lookup(&self, st: Vec2) -> Spectrum {
-        self.map.bilerp(st)
+        self.mip.lookup(st, Vec2::ZERO, Vec2::ZERO)
     }
 }
 

@@ -162,8 +162,9 @@ impl<T: TexValue> MipMap<T> {
         self.levels[self.levels.len() - 1].texel(0, 0)
     }
 
-    /// pbrt-v3's trilinear lookup over a square footprint `width` wide.
-    fn trilinear_lookup(&self, st: Vec2, width: f32) -> T {
+    /// pbrt-v3's trilinear lookup over a square footprint `width` wide (its
+    /// `MIPMap::Lookup(st, width)`).
+    pub fn lookup_width(&self, st: Vec2, width: f32) -> T {
         let n = self.levels.len();
         let level = n as f32 - 1.0 + width.max(1e-8).log2();
         if level < 0.0 {
@@ -185,7 +186,7 @@ impl<T: TexValue> MipMap<T> {
         }
         if self.trilinear {
             let width = dst0.abs().max_element().max(dst1.abs().max_element());
-            return self.trilinear_lookup(st, width);
+            return self.lookup_width(st, width);
         }
         let (mut major, mut minor) = (dst0, dst1);
         if major.length_squared() < minor.length_squared() {
