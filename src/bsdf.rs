@@ -12,6 +12,7 @@ use crate::geometry::{Frame, Spectrum, SurfaceInteraction, Vec2, Vec3};
 mod bxdf;
 mod fresnel;
 
+pub(crate) use bxdf::sample_microfacet_reflection;
 pub use bxdf::{Bxdf, BxdfType, LobeSample};
 pub use fresnel::{fr_conductor, fr_dielectric, reflect, refract, Fresnel};
 /// The most lobes a BSDF holds (pbrt-v3's `MaxBxDFs`).

@@ -10,7 +10,9 @@
 //! replaces the diffuse lobe by a smooth refraction into the object): acr has no BSSRDF, so a
 //! non-zero `scatterdistance` warns and the surface keeps pbrt-v3's diffuse lobe instead.
 
-use crate::bsdf::{fr_dielectric, reflect, Bsdf, Bxdf, BxdfType, LobeSample};
+use crate::bsdf::{
+    fr_dielectric, reflect, sample_microfacet_reflection, Bsdf, Bxdf, BxdfType, LobeSample,
+};
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
 use crate::microfacet::{abs_cos_theta, same_hemisphere, TrowbridgeReitz};
 use crate::sampling::cosine_sample_hemisphere;
@@ -303,23 +305,11 @@ impl DisneyBxdf {
                 wi
             }
             DisneyBxdf::Specular { distribution, .. } => {
-                if wo.z == 0.0 {
-                    return None;
-                }
-                let wh = distribution.sample_wh(wo, u);
-                // pbrt-v3 gives up below 0; at 0 its pdf would divide by zero.
-                if wo.dot(wh).is_nan() || wo.dot(wh) <= 0.0 {
-                    return None;
-                }
-                let wi = reflect(wo, wh);
-                if !same_hemisphere(wo, wi) {
-                    return None;
-                }
-                // The density of the sampled normal, as pbrt-v3 (not recomputed from wi).
+                let (wi, pdf) = sample_microfacet_reflection(&distribution, wo, u)?;
                 return Some(LobeSample {
                     wi,
                     f: self.f(wo, wi),
-                    pdf: distribution.pdf(wo, wh) / (4.0 * wo.dot(wh)),
+                    pdf,
                     kind: self.kind(),
                 });
             }

@@ -53,6 +53,13 @@ fn safe_sqrt(x: f32) -> f32 {
     x.max(0.0).sqrt()
 }
 
+/// A local direction's angles to the fibre (x along it): sin and cos of the longitudinal angle,
+/// and the azimuth about the fibre.
+#[inline]
+fn fibre_angles(w: Vec3) -> (f32, f32, f32) {
+    (w.x, safe_sqrt(1.0 - sqr(w.x)), w.z.atan2(w.y))
+}
+
 /// The modified Bessel function I0 by its first ten series terms (pbrt-v3's `I0`).
 fn i0(x: f32) -> f32 {
     let mut val = 0.0f32;
@@ -303,12 +310,8 @@ impl HairBsdf {
     /// orders of M_p A_p N_p, divided by |cos theta| to the normal as pbrt-v3 does (the
     /// integrator's cosine cancels it: a fibre is not a surface).
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Spectrum {
-        let sin_o = wo.x;
-        let cos_o = safe_sqrt(1.0 - sqr(sin_o));
-        let phi_o = wo.z.atan2(wo.y);
-        let sin_i = wi.x;
-        let cos_i = safe_sqrt(1.0 - sqr(sin_i));
-        let phi_i = wi.z.atan2(wi.y);
+        let (sin_o, cos_o, phi_o) = fibre_angles(wo);
+        let (sin_i, cos_i, phi_i) = fibre_angles(wi);
         let t = self.transmittance(sin_o, cos_o);
         let gamma_t = self.gamma_t(sin_o, cos_o);
         let dphi = phi_i - phi_o;
@@ -370,9 +373,7 @@ impl HairBsdf {
     /// is split into two ([`demux_float`]); one chooses the order p by [`HairBsdf::ap_pdf`], one
     /// samples N_p and two M_p. Returns (wi, f, pdf).
     pub fn sample_f(&self, wo: Vec3, u2: Vec2) -> (Vec3, Spectrum, f32) {
-        let sin_o = wo.x;
-        let cos_o = safe_sqrt(1.0 - sqr(sin_o));
-        let phi_o = wo.z.atan2(wo.y);
+        let (sin_o, cos_o, phi_o) = fibre_angles(wo);
         let mut u = [demux_float(u2.x), demux_float(u2.y)];
         let ap_pdf = self.ap_pdf(cos_o);
         let mut p = 0;
@@ -407,12 +408,8 @@ impl HairBsdf {
 
     /// The density with which [`HairBsdf::sample_f`] picks `wi` (pbrt-v3's `HairBSDF::Pdf`).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let sin_o = wo.x;
-        let cos_o = safe_sqrt(1.0 - sqr(sin_o));
-        let phi_o = wo.z.atan2(wo.y);
-        let sin_i = wi.x;
-        let cos_i = safe_sqrt(1.0 - sqr(sin_i));
-        let phi_i = wi.z.atan2(wi.y);
+        let (sin_o, cos_o, phi_o) = fibre_angles(wo);
+        let (sin_i, cos_i, phi_i) = fibre_angles(wi);
         let gamma_t = self.gamma_t(sin_o, cos_o);
         let ap_pdf = self.ap_pdf(cos_o);
         self.pdf_terms(&ap_pdf, sin_o, cos_o, sin_i, cos_i, phi_i - phi_o, gamma_t)

@@ -40,6 +40,11 @@ impl RgbImage {
     }
 }
 
+/// Whether `path` names an EXR (by its extension, any case).
+pub fn is_exr(path: &Path) -> bool {
+    extension(path) == "exr"
+}
+
 /// The lower-case extension of `path`, without the dot.
 fn extension(path: &Path) -> String {
     path.extension()
@@ -270,7 +275,7 @@ pub struct Frame {
 /// Writes `img`, a crop placed in `frame` (EXR keeps the placement; PNG and PFM hold the crop
 /// alone).
 pub fn write_image_in_frame(path: &Path, img: &RgbImage, frame: Frame) -> Result<(), String> {
-    if extension(path) == "exr" && img.pixels.len() == img.width * img.height {
+    if is_exr(path) && img.pixels.len() == img.width * img.height {
         return write_exr_in(path, img, Some(frame));
     }
     write_image(path, img)
@@ -286,7 +291,7 @@ pub fn read_image_with_frame(path: &Path) -> Result<(RgbImage, Frame), String> {
         x0: 0,
         y0: 0,
     };
-    if extension(path) == "exr" {
+    if is_exr(path) {
         let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
         if let Some(h) = meta.headers.first() {
             let display = h.shared_attributes.display_window;

@@ -3,55 +3,12 @@
 //! whole-frame render byte for byte), sample ranges (`--sample-offset`, `--mergeable`) merged
 //! by their weights, clean stops on SIGTERM with partial writes, `--quick`.
 
+mod common;
+
 use acr::image_io::read_image_with_frame;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-/// A fresh folder for one test's files.
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("acr-merge-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn acr(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_acr"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str]) {
-    let o = acr(args);
-    assert!(
-        o.status.success(),
-        "acr {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
-/// Fails cleanly (non-zero, a message, no panic) saying `says`.
-fn fails(args: &[&str], says: &str) {
-    let o = acr(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && o.status.code().is_some(),
-        "acr {args:?}: {err}"
-    );
-    assert!(
-        !err.contains("panicked") && err.contains(says),
-        "acr {args:?}: {err}"
-    );
-}
-
-fn scene() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/pbrt-v3/quadrics.pbrt")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{fails, ok, s, scene, temp_dir};
+use std::path::PathBuf;
+use std::process::Command;
 
 /// The largest difference between two images' channels, relative to the second's (at least
 /// 1e-3).

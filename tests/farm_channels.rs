@@ -3,40 +3,13 @@
 //! their variance moments, and the image streamed to a tev viewer (`--display-server`), checked
 //! against a stand-in for tev that decodes its protocol.
 
+mod common;
+
 use acr::exr_channels::Channels;
 use acr::image_io::read_image;
+use common::{acr, ok, s, scene, temp_dir};
 use std::io::Read;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("acr-channels-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn acr(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_acr"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = acr(args);
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert!(o.status.success(), "acr {args:?}: {err}");
-    err
-}
-
-fn scene() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/pbrt-v3/quadrics.pbrt")
-}
+use std::path::Path;
 
 /// Channel `name` of `layer`, or a failure naming what the file has.
 fn channel<'a>(layer: &'a Channels, name: &str) -> &'a [f32] {

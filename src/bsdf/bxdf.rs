@@ -10,6 +10,47 @@ use std::f32::consts::FRAC_1_PI;
 /// The largest u < 1 in f32 (pbrt-v3's `OneMinusEpsilon`).
 pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// Perfect refraction of local `wo` through the boundary between `eta_a` (the normal's side)
+/// and `eta_b`: the direction and (eta_i / eta_t)^2, the radiance scale across it. `None` on
+/// total internal reflection or a grazing result.
+fn specular_refraction(wo: Vec3, eta_a: f32, eta_b: f32) -> Option<(Vec3, f32)> {
+    let (eta_i, eta_t) = if cos_theta(wo) > 0.0 {
+        (eta_a, eta_b)
+    } else {
+        (eta_b, eta_a)
+    };
+    let n = if wo.z < 0.0 { -Vec3::Z } else { Vec3::Z };
+    let wi = refract(wo, n, eta_i / eta_t)?;
+    if wi.z == 0.0 {
+        return None;
+    }
+    Some((wi, (eta_i * eta_i) / (eta_t * eta_t)))
+}
+
+/// Samples a microfacet normal of `distribution` for local `wo` and reflects `wo` about it
+/// (pbrt-v3's `MicrofacetReflection::Sample_f`): the direction and its density, from the
+/// sampled normal's (not recomputed from the direction). `None` when `wo` is grazing, the
+/// normal faces away (pbrt-v3 gives up below 0; at 0 its density would divide by zero), or the
+/// reflection leaves the hemisphere.
+pub(crate) fn sample_microfacet_reflection(
+    distribution: &TrowbridgeReitz,
+    wo: Vec3,
+    u: Vec2,
+) -> Option<(Vec3, f32)> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    let wh = distribution.sample_wh(wo, u);
+    if wo.dot(wh).is_nan() || wo.dot(wh) <= 0.0 {
+        return None;
+    }
+    let wi = reflect(wo, wh);
+    if !same_hemisphere(wo, wi) {
+        return None;
+    }
+    Some((wi, distribution.pdf(wo, wh) / (4.0 * wo.dot(wh))))
+}
+
 /// The kind of a lobe, as pbrt-v3's `BxDFType` bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BxdfType(u8);
@@ -346,20 +387,8 @@ impl Bxdf {
                 }
             }
             Bxdf::SpecularTransmission { t, eta_a, eta_b } => {
-                let entering = cos_theta(wo) > 0.0;
-                let (eta_i, eta_t) = if entering {
-                    (eta_a, eta_b)
-                } else {
-                    (eta_b, eta_a)
-                };
-                let n = if wo.z < 0.0 { -Vec3::Z } else { Vec3::Z };
-                let wi = refract(wo, n, eta_i / eta_t)?;
-                if wi.z == 0.0 {
-                    return None;
-                }
-                let ft = t
-                    * (1.0 - fr_dielectric(cos_theta(wi), eta_a, eta_b))
-                    * ((eta_i * eta_i) / (eta_t * eta_t));
+                let (wi, eta2) = specular_refraction(wo, eta_a, eta_b)?;
+                let ft = t * (1.0 - fr_dielectric(cos_theta(wi), eta_a, eta_b)) * eta2;
                 LobeSample {
                     wi,
                     f: ft / abs_cos_theta(wi),
@@ -381,18 +410,8 @@ impl Bxdf {
                         kind: T::SPECULAR.or(T::REFLECTION),
                     }
                 } else {
-                    let entering = cos_theta(wo) > 0.0;
-                    let (eta_i, eta_t) = if entering {
-                        (eta_a, eta_b)
-                    } else {
-                        (eta_b, eta_a)
-                    };
-                    let n = if wo.z < 0.0 { -Vec3::Z } else { Vec3::Z };
-                    let wi = refract(wo, n, eta_i / eta_t)?;
-                    if wi.z == 0.0 {
-                        return None;
-                    }
-                    let ft = t * (1.0 - fr) * ((eta_i * eta_i) / (eta_t * eta_t));
+                    let (wi, eta2) = specular_refraction(wo, eta_a, eta_b)?;
+                    let ft = t * (1.0 - fr) * eta2;
                     LobeSample {
                         wi,
                         f: ft / abs_cos_theta(wi),
@@ -402,21 +421,11 @@ impl Bxdf {
                 }
             }
             Bxdf::MicrofacetReflection { distribution, .. } => {
-                if wo.z == 0.0 {
-                    return None;
-                }
-                let wh = distribution.sample_wh(wo, u);
-                if wo.dot(wh).is_nan() || wo.dot(wh) <= 0.0 {
-                    return None;
-                }
-                let wi = reflect(wo, wh);
-                if !same_hemisphere(wo, wi) {
-                    return None;
-                }
+                let (wi, pdf) = sample_microfacet_reflection(&distribution, wo, u)?;
                 LobeSample {
                     wi,
                     f: self.f(wo, wi),
-                    pdf: distribution.pdf(wo, wh) / (4.0 * wo.dot(wh)),
+                    pdf,
                     kind,
                 }
             }

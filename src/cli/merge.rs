@@ -7,7 +7,7 @@
 use super::mergeable::Sums;
 use crate::exr_channels::read_attribute;
 use crate::geometry::Spectrum;
-use crate::image_io::{read_image_with_frame, write_image, Frame, RgbImage};
+use crate::image_io::{is_exr, read_image_with_frame, write_image, Frame, RgbImage};
 use std::path::{Path, PathBuf};
 
 /// Assembles the crops `inputs` into `output`.
@@ -16,7 +16,7 @@ pub fn command(output: &Path, inputs: &[PathBuf]) -> Result<(), String> {
         return Err("acr merge needs at least one input image".to_owned());
     }
     let read = |p: &PathBuf| Sums::read(p).map_err(|e| format!("{}: {e}", p.display()));
-    let first = if extension_is_exr(&inputs[0]) {
+    let first = if is_exr(&inputs[0]) {
         read(&inputs[0])?
     } else {
         None
@@ -132,14 +132,10 @@ pub fn command(output: &Path, inputs: &[PathBuf]) -> Result<(), String> {
     write_image(output, &image).map_err(|e| format!("{}: {e}", output.display()))
 }
 
-fn extension_is_exr(p: &Path) -> bool {
-    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-}
-
 /// Writes merged sample ranges: a mergeable EXR again (so merges chain), or the image alone
 /// in another format.
 fn write_sums(output: &Path, total: &Sums) -> Result<(), String> {
-    if extension_is_exr(output) {
+    if is_exr(output) {
         return total
             .write(output)
             .map_err(|e| format!("{}: {e}", output.display()));

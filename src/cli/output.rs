@@ -7,7 +7,7 @@ use crate::cli::mergeable::Sums;
 use crate::exr_channels::{Attribute, Channels};
 use crate::features::FeatureImage;
 use crate::geometry::Spectrum;
-use crate::image_io::{write_image_in_frame, Frame, RgbImage};
+use crate::image_io::{is_exr, write_image_in_frame, Frame, RgbImage};
 use acr_plugins::{Film, PixelStats};
 use std::path::{Path, PathBuf};
 
@@ -161,11 +161,7 @@ impl Output {
         aovs: Vec<(String, Vec<f32>)>,
         spp: u32,
     ) -> Result<(), String> {
-        let is_exr = self
-            .path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-        if !is_exr {
+        if !is_exr(&self.path) {
             let rgb = RgbImage {
                 width: self.size.0,
                 height: self.size.1,

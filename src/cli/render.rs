@@ -338,11 +338,8 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         }
     }
     let output = output_path(args, scene.film.filename.as_deref());
-    if args.mergeable
-        && !output
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-    {
+    let is_exr = crate::image_io::is_exr(&output);
+    if args.mergeable && !is_exr {
         return Err(format!(
             "--mergeable writes an EXR, not {}",
             output.display()
@@ -364,9 +361,6 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         y0: scene.film.crop[2] as usize,
     };
     let (w, h) = scene.film.size();
-    let is_exr = output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     let mut out = Output {
         path: output.clone(),
         frame,
@@ -376,7 +370,12 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         can_merge: is_exr && splats && plugins.sampler.streams() == 1,
         offset: args.sample_offset,
         channel_aovs: Vec::new(),
-        scene: crate::cli::output::scene_hash(&desc),
+        // Only an EXR carries the hash: a PNG or PFM render does not read the scene again.
+        scene: if is_exr {
+            crate::cli::output::scene_hash(&desc)
+        } else {
+            0
+        },
     };
     for a in &aovs {
         if out.holds(a) {

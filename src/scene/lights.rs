@@ -3,6 +3,7 @@
 
 use super::Builder;
 use crate::geometry::{Spectrum, Vec3};
+use crate::image_io::RgbImage;
 use crate::light::{spot_frame, EnvMap, Light};
 use crate::light_image::LightImage;
 use acr_parser::{Error, ParamList, ParamType, PluginDesc, Result};
@@ -68,19 +69,13 @@ impl Builder<'_> {
             }
             "infinite" | "exinfinite" => {
                 let l = rgb_param(params, "L", Spectrum::ONE)? * scale;
-                let map = match params.string("mapname")? {
-                    Some(name) if !name.is_empty() => {
-                        let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
-                        let path = crate::texture::resolve_file(name, loc, main_dir);
-                        let img = crate::image_io::read_image(&path, false)
-                            .map_err(|e| Error::at(loc, format!("cannot read \"{name}\": {e}")))?;
-                        Some(EnvMap::new(Arc::new(img)))
-                    }
+                let map = match map_image(p, main_dir)? {
+                    Some((img, _, _)) => Some(EnvMap::new(Arc::new(img))),
                     // pbrt-v3 gives a constant environment a 1x1 map and samples it through
                     // the map's distribution (uniform in (phi, theta), denser at the poles);
                     // doing the same keeps the variance, and the spatial light choice, as
                     // pbrt-v3 has them.
-                    _ => Some(EnvMap::new(Arc::new(crate::image_io::RgbImage {
+                    None => Some(EnvMap::new(Arc::new(crate::image_io::RgbImage {
                         width: 1,
                         height: 1,
                         pixels: vec![Spectrum::ONE],
@@ -99,19 +94,12 @@ impl Builder<'_> {
                 // pbrt-v3 reads the image with ReadImage: PNG values as stored, no sRGB
                 // decoding. Without "mapname" it has no image (and emits I unscaled); acr
                 // makes an unreadable one an error where pbrt-v3 goes on without it.
-                let map = match params.string("mapname")? {
-                    Some(name) if !name.is_empty() => {
-                        let loc = params.get("mapname").map_or(&p.loc, |x| &x.loc);
-                        let path = crate::texture::resolve_file(name, loc, main_dir);
-                        let img = crate::image_io::read_image(&path, false)
-                            .map_err(|e| Error::at(loc, format!("cannot read \"{name}\": {e}")))?;
-                        Some(
-                            LightImage::new(&img).ok_or_else(|| {
-                                Error::at(loc, format!("\"{name}\" has no pixels"))
-                            })?,
-                        )
-                    }
-                    _ => None,
+                let map = match map_image(p, main_dir)? {
+                    Some((img, loc, name)) => Some(
+                        LightImage::new(&img)
+                            .ok_or_else(|| Error::at(&loc, format!("\"{name}\" has no pixels")))?,
+                    ),
+                    None => None,
                 };
                 let light = if p.kind == "goniometric" {
                     Light::goniometric(world_from_light, intensity, map)
@@ -181,4 +169,22 @@ fn vec3_param(params: &ParamList, name: &str, default: Vec3) -> Result<Vec3> {
     Ok(v.map_or(default, |a| {
         Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
     }))
+}
+
+/// The image a light's `"string mapname"` names, read as pbrt-v3's `ReadImage` does (values
+/// as stored, no sRGB decoding), with where and how it was named; `None` without one (or with
+/// an empty name). An unreadable file is an error there.
+fn map_image(
+    p: &PluginDesc,
+    main_dir: &Path,
+) -> Result<Option<(RgbImage, acr_parser::Loc, String)>> {
+    let name = match p.params.string("mapname")? {
+        Some(name) if !name.is_empty() => name,
+        _ => return Ok(None),
+    };
+    let loc = p.params.get("mapname").map_or(&p.loc, |x| &x.loc).clone();
+    let path = crate::texture::resolve_file(name, &loc, main_dir);
+    let img = crate::image_io::read_image(&path, false)
+        .map_err(|e| Error::at(&loc, format!("cannot read \"{name}\": {e}")))?;
+    Ok(Some((img, loc, name.to_owned())))
 }
