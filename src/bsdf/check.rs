@@ -142,3 +142,25 @@ pub fn test_directions() -> [Vec3; 4] {
         Vec3::new(-0.4, 0.2, -0.7).normalize(),
     ]
 }
+
+/// Directions that break naive BSDF code: the poles, the horizon, a hair above and below it,
+/// and zero.
+pub fn degenerate_directions() -> [Vec3; 6] {
+    [
+        Vec3::Z,
+        -Vec3::Z,
+        Vec3::X,
+        Vec3::new(1.0, 0.0, 1e-7).normalize(),
+        Vec3::new(0.0, 1.0, -1e-7).normalize(),
+        Vec3::ZERO,
+    ]
+}
+
+/// Sample values at the ends and the middle of [0, 1).
+pub fn edge_samples() -> [Vec2; 3] {
+    [
+        Vec2::ZERO,
+        Vec2::splat(0.5),
+        Vec2::splat(super::bxdf::ONE_MINUS_EPSILON),
+    ]
+}

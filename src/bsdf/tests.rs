@@ -1,6 +1,5 @@
 //! Tests of the BSDFs: lobes, frames, sampling against evaluation.
 
-use super::bxdf::ONE_MINUS_EPSILON;
 use super::check::*;
 use super::*;
 use crate::microfacet::TrowbridgeReitz;
@@ -353,15 +352,8 @@ fn degenerate_inputs_give_no_nan() {
         distribution: TrowbridgeReitz::new(0.0, 0.0),
         fresnel: Fresnel::NoOp,
     });
-    let dirs = [
-        Vec3::Z,
-        -Vec3::Z,
-        Vec3::X,
-        Vec3::new(1.0, 0.0, 1e-7).normalize(),
-        Vec3::new(0.0, 1.0, -1e-7).normalize(),
-        Vec3::ZERO,
-    ];
-    let us = [Vec2::ZERO, Vec2::splat(0.5), Vec2::splat(ONE_MINUS_EPSILON)];
+    let dirs = degenerate_directions();
+    let us = edge_samples();
     for bxdf in all {
         let b = local_bsdf(&[bxdf], 1.5);
         for wo in dirs {

@@ -396,15 +396,8 @@ fn defaults_warnings_and_degenerate_directions() {
         distribution: TrowbridgeReitz::new(0.001, 0.001),
         eta: 1.5,
     }));
-    let dirs = [
-        Vec3::Z,
-        -Vec3::Z,
-        Vec3::X,
-        Vec3::new(1.0, 0.0, 1e-7).normalize(),
-        Vec3::new(0.0, 1.0, -1e-7).normalize(),
-        Vec3::ZERO,
-    ];
-    let us = [Vec2::ZERO, Vec2::splat(0.5), Vec2::splat(ONE_MINUS_EPSILON)];
+    let dirs = degenerate_directions();
+    let us = edge_samples();
     for l in lobes {
         for wo in dirs {
             for wi in dirs {
