@@ -29,6 +29,9 @@ pub struct LightSample {
 pub struct EnvMap {
     image: Arc<RgbImage>,
     distribution: Distribution2D,
+    /// A one-pixel map's radiance and its distribution's (constant) density: such a map
+    /// needs no spherical coordinates for a lookup (pbrt-v3's constant environment).
+    constant: Option<(Spectrum, f32)>,
 }
 
 /// Which static world primitive emits.
@@ -148,9 +151,13 @@ impl EnvMap {
                 values[v * w + u] = crate::spectrum_luminance(image.pixels[v * w + u]) * sin_theta;
             }
         }
+        let distribution = Distribution2D::new(&values, w, h);
+        let constant = (image.width == 1 && image.height == 1)
+            .then(|| (image.pixels[0], distribution.pdf(Vec2::splat(0.5))));
         Self {
-            distribution: Distribution2D::new(&values, w, h),
+            distribution,
             image,
+            constant,
         }
     }
 
@@ -448,6 +455,10 @@ impl Light {
                 light_from_world,
                 ..
             } => match map {
+                Some(EnvMap {
+                    constant: Some((c, _)),
+                    ..
+                }) => *l * *c,
                 Some(m) => {
                     let wl = light_from_world.transform_vector3(d).normalize();
                     *l * m.lookup(direction_to_st(wl))
@@ -466,6 +477,18 @@ impl Light {
                 light_from_world,
                 ..
             } => match map {
+                Some(EnvMap {
+                    constant: Some((_, pdf)),
+                    ..
+                }) => {
+                    let z = light_from_world.transform_vector3(d).normalize().z;
+                    let sin_theta = (1.0 - z * z).max(0.0).sqrt();
+                    if sin_theta == 0.0 {
+                        0.0
+                    } else {
+                        pdf / (2.0 * PI * PI * sin_theta)
+                    }
+                }
                 Some(m) => {
                     let wl = light_from_world.transform_vector3(d).normalize();
                     let st = direction_to_st(wl);
@@ -561,4 +584,43 @@ pub fn spot_frame(dir: Vec3) -> Mat4 {
         glam::Vec4::W,
     )
     .transpose()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn infinite(width: usize, rgb: Spectrum) -> Light {
+        let image = RgbImage {
+            width,
+            height: 1,
+            pixels: vec![rgb; width],
+        };
+        let m = Mat4::from_rotation_x(0.7) * Mat4::from_rotation_z(-0.3);
+        Light::Infinite {
+            l: Spectrum::new(2.0, 1.0, 0.5),
+            map: Some(EnvMap::new(Arc::new(image))),
+            light_from_world: m.inverse(),
+            world_from_light: m,
+            world_radius: 10.0,
+        }
+    }
+
+    /// A one-pixel map (pbrt-v3's constant environment) answers without spherical
+    /// coordinates: the same radiance and density as a uniform map read through them.
+    #[test]
+    fn a_constant_environment_matches_the_general_lookup() {
+        let rgb = Spectrum::new(0.3, 0.6, 0.9);
+        let (constant, general) = (infinite(1, rgb), infinite(2, rgb));
+        for k in 0..1024 {
+            let u = Vec2::new(
+                ((k % 32) as f32 + 0.5) / 32.0,
+                ((k / 32) as f32 + 0.5) / 32.0,
+            );
+            let d = crate::sampling::uniform_sample_sphere(u);
+            assert_eq!(constant.le(d), general.le(d));
+            let (a, b) = (constant.pdf_le(d), general.pdf_le(d));
+            assert!((a - b).abs() <= 1e-4 * b, "{d}: {a} against {b}");
+        }
+    }
 }

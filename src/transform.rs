@@ -44,16 +44,47 @@ fn decompose(m: &DMat4) -> Decomposed {
     }
 }
 
-/// pbrt-v3's slerp: normalised lerp when the quaternions are nearly parallel.
-fn slerp(t: f32, a: Quat, b: Quat) -> Quat {
-    let cos_theta = a.dot(b);
-    if cos_theta > 0.9995 {
-        (a * (1.0 - t) + b * t).normalize()
-    } else {
-        let theta = cos_theta.clamp(-1.0, 1.0).acos();
-        let thetap = theta * t;
-        let qperp = (b - a * cos_theta).normalize();
-        a * thetap.cos() + qperp * thetap.sin()
+/// pbrt-v3's slerp from one rotation to another (normalised lerp when they are nearly
+/// parallel), with the angle and the perpendicular quaternion computed once: they do not
+/// depend on the time, and a moving instance interpolates once per ray.
+#[derive(Clone, Copy, Debug)]
+struct Slerp {
+    a: Quat,
+    b: Quat,
+    cos_theta: f32,
+    theta: f32,
+    perp: Quat,
+}
+
+impl Slerp {
+    /// The path from `a` to `b`.
+    fn new(a: Quat, b: Quat) -> Self {
+        let cos_theta = a.dot(b);
+        let (theta, perp) = if cos_theta > 0.9995 {
+            (0.0, Quat::IDENTITY)
+        } else {
+            (
+                cos_theta.clamp(-1.0, 1.0).acos(),
+                (b - a * cos_theta).normalize(),
+            )
+        };
+        Self {
+            a,
+            b,
+            cos_theta,
+            theta,
+            perp,
+        }
+    }
+
+    /// The rotation at `t` in [0, 1].
+    fn at(&self, t: f32) -> Quat {
+        if self.cos_theta > 0.9995 {
+            (self.a * (1.0 - t) + self.b * t).normalize()
+        } else {
+            let thetap = self.theta * t;
+            self.a * thetap.cos() + self.perp * thetap.sin()
+        }
     }
 }
 
@@ -65,6 +96,7 @@ pub struct MotionTransform {
     start_time: f32,
     end_time: f32,
     parts: Option<[Decomposed; 2]>,
+    rotation: Option<Slerp>,
 }
 
 impl MotionTransform {
@@ -85,6 +117,7 @@ impl MotionTransform {
             end: desc.end.as_mat4(),
             start_time: desc.start_time as f32,
             end_time: desc.end_time as f32,
+            rotation: parts.map(|[a, b]| Slerp::new(a.rotation, b.rotation)),
             parts,
         }
     }
@@ -96,7 +129,7 @@ impl MotionTransform {
 
     /// The transform at `time` (clamped to the start and end).
     pub fn at(&self, time: f32) -> Mat4 {
-        let Some([a, b]) = &self.parts else {
+        let (Some([a, b]), Some(rotation)) = (&self.parts, &self.rotation) else {
             return self.start;
         };
         if time <= self.start_time {
@@ -107,7 +140,7 @@ impl MotionTransform {
         }
         let dt = (time - self.start_time) / (self.end_time - self.start_time);
         let trans = a.translation.lerp(b.translation, dt);
-        let rot = slerp(dt, a.rotation, b.rotation);
+        let rot = rotation.at(dt);
         let scale = Mat4::from_cols(
             a.scale.x_axis.lerp(b.scale.x_axis, dt),
             a.scale.y_axis.lerp(b.scale.y_axis, dt),

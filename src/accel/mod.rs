@@ -215,9 +215,10 @@ impl Geometry {
         self.prims = ordered;
         self.part_count = parts.len();
         self.bvh = Some(join_parts(parts));
+        // Written once per primitive (tens of MB on a large mesh): in parallel.
         self.tri_verts = self
             .prims
-            .iter()
+            .par_iter()
             .map(|p| match p.kind {
                 PrimKind::Triangle { mesh, tri } => {
                     TriangleVerts::new(&self.meshes[mesh as usize].vertices(tri as usize))
