@@ -10,6 +10,9 @@ pbrt-v4 has no direct-lighting integrator: its upgrade turns pbrt-v3's `directli
 `path` with maxdepth 1, which stops where acr's `directlighting` follows specular chains. On
 such a scene acr also renders pbrt-v4's work (`--integrator path`, that maxdepth), and the
 speed-up on pbrt-v4 is taken from that run (the row says so); on pbrt-v3 from the scene's own.
+The same holds for the light choice: the upgrade turns pbrt-v3's `lightsamplestrategy "spatial"`
+into pbrt-v4's light BVH, so acr renders such a scene with `lightsamplestrategy=bvh` for the
+comparison with pbrt-v4.
 
 usage: python3 bench/versus.py [--acr PATH] [--pbrt-v3 PATH] [--pbrt-v4 PATH] [--threads N]
            [--runs N] [--spp N] [--scene FILE ...] [--large DIR] [--out FILE.md]
@@ -84,16 +87,26 @@ def upgraded(pbrt_v4, scene):
 
 
 def v4_work(original, v4):
-    """acr's arguments for the work pbrt-v4 does on the upgraded scene `v4` when the upgrade
-    changed the integrator (pbrt-v3's directlighting becomes path); None when it did not."""
+    """acr's arguments for the work pbrt-v4 does on the upgraded scene `v4` where the upgrade
+    changed it, and their description; None where it did not. The upgrade turns pbrt-v3's
+    directlighting into path (with maxdepth 1), and a lightsamplestrategy pbrt-v4 lacks
+    ("spatial", pbrt-v3's default) into its own ("bvh")."""
     # Directives at the start of a line: "##Integrator ..." is a comment.
     scene = inlined(original, os.path.dirname(original))
-    if not re.search(r'^\s*Integrator\s+"directlighting"', scene, re.MULTILINE):
-        return None
-    found = re.search(r'^\s*Integrator\s+"path"\s+"integer maxdepth"\s*\[\s*(\d+)',
-                      open(v4).read(), re.MULTILINE)
-    depth = found.group(1) if found else "5"
-    return ["--integrator", "path", "--set", f"integrator.maxdepth={depth}"]
+    text = open(v4).read()
+    args, what = [], []
+    if re.search(r'^\s*Integrator\s+"directlighting"', scene, re.MULTILINE):
+        found = re.search(r'^\s*Integrator\s+"path"\s+"integer maxdepth"\s*\[\s*(\d+)',
+                          text, re.MULTILINE)
+        depth = found.group(1) if found else "5"
+        args += ["--integrator", "path", "--set", f"integrator.maxdepth={depth}"]
+        what.append(f"path maxdepth {depth}")
+    strategy = re.compile(r'"string (?:lightsamplestrategy|lightsampler)"\s*\[?\s*"(\w+)"')
+    theirs, ours = strategy.search(text), strategy.search(scene)
+    if theirs and ours and theirs.group(1) != ours.group(1):
+        args += ["--set", f"integrator.lightsamplestrategy={theirs.group(1)}"]
+        what.append(f"lightsamplestrategy {theirs.group(1)}")
+    return (args, ", ".join(what)) if args else None
 
 
 def with_spp(scene, spp):
@@ -257,10 +270,9 @@ def render_all(original, scene, renderers, args, tmp):
                 acr = dict(renderers).get("acr")
                 if work and acr:
                     cmd = [acr, "render", scene, "-o", image, "--threads", threads, "--quiet"]
-                    result = measure("acr as pbrt-v4's upgrade", cmd + work, args.runs)
+                    result = measure("acr as pbrt-v4's upgrade", cmd + work[0], args.runs)
                     if result is not None:
-                        depth = work[-1].split("=")[1]
-                        results["acr, pbrt-v4's work"] = (*result, f"path maxdepth {depth}")
+                        results["acr, pbrt-v4's work"] = (*result, work[1])
             finally:
                 os.remove(v4)
     return name, results
