@@ -64,7 +64,7 @@ impl Channels {
     }
 
     /// Writes the layer (lossless compression).
-    pub fn write(&self, path: &Path) -> std::result::Result<(), String> {
+    pub fn write(self, path: &Path) -> std::result::Result<(), String> {
         let n = self.width * self.height;
         if let Some((name, v)) = self.channels.iter().find(|(_, v)| v.len() != n) {
             return Err(format!(
@@ -76,8 +76,8 @@ impl Channels {
         }
         let list = self
             .channels
-            .iter()
-            .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v.clone())))
+            .into_iter()
+            .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v)))
             .collect::<Vec<_>>();
         let channels = AnyChannels::sort(SmallVec::from_vec(list));
         let mut attributes = LayerAttributes {

@@ -174,15 +174,16 @@ impl FilmSettings {
     }
 }
 
-/// The samples drawn for one pixel (those whose raster position lies in it), unfiltered.
+/// The samples drawn for one pixel (those whose raster position lies in it), unfiltered:
+/// their count, mean and sum of squared deviations (Welford's running form, stable in f32).
+/// Single precision halves the film's per-pixel statistics (28 bytes a pixel, not 56: 28 MB
+/// less at 1152x864); the sums a mergeable file needs are rebuilt from them in f64.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelStats {
     /// How many.
     pub count: u32,
-    /// Sum of their radiance, per channel.
-    pub sum: [f64; 3],
-    /// Sum of their squared radiance, per channel.
-    pub sum_sq: [f64; 3],
+    mean: [f32; 3],
+    m2: [f32; 3],
 }
 
 impl PixelStats {
@@ -190,24 +191,32 @@ impl PixelStats {
     #[inline]
     pub fn add(&mut self, l: Spectrum) {
         self.count += 1;
+        let inv = 1.0 / self.count as f32;
         for (c, v) in [l.x, l.y, l.z].into_iter().enumerate() {
-            let v = f64::from(v);
-            self.sum[c] += v;
-            self.sum_sq[c] += v * v;
+            let delta = v - self.mean[c];
+            self.mean[c] += delta * inv;
+            self.m2[c] += delta * (v - self.mean[c]);
         }
     }
 
     /// The mean radiance (zero without samples).
     pub fn mean(&self) -> Spectrum {
-        if self.count == 0 {
-            return Spectrum::ZERO;
-        }
+        Spectrum::from_array(self.mean)
+    }
+
+    /// The sum of the samples' radiance, per channel.
+    pub fn sum(&self) -> [f64; 3] {
         let n = f64::from(self.count);
-        Spectrum::new(
-            (self.sum[0] / n) as f32,
-            (self.sum[1] / n) as f32,
-            (self.sum[2] / n) as f32,
-        )
+        self.mean.map(|m| f64::from(m) * n)
+    }
+
+    /// The sum of the samples' squared radiance, per channel.
+    pub fn sum_sq(&self) -> [f64; 3] {
+        let n = f64::from(self.count);
+        std::array::from_fn(|c| {
+            let m = f64::from(self.mean[c]);
+            f64::from(self.m2[c].max(0.0)) + n * m * m
+        })
     }
 
     /// The variance of the mean per channel: the unbiased sample variance over the count
@@ -216,12 +225,8 @@ impl PixelStats {
         if self.count < 2 {
             return Spectrum::ZERO;
         }
-        let n = f64::from(self.count);
-        let v = |c: usize| {
-            let mean = self.sum[c] / n;
-            ((self.sum_sq[c] - n * mean * mean).max(0.0) / (n - 1.0) / n) as f32
-        };
-        Spectrum::new(v(0), v(1), v(2))
+        let n = self.count as f32;
+        Spectrum::from_array(self.m2.map(|m2| m2.max(0.0) / (n - 1.0) / n))
     }
 }
 
@@ -691,6 +696,41 @@ impl Film {
 mod tests {
     use super::*;
     use crate::filters::{BoxFilter, GaussianFilter};
+
+    /// The f32 running statistics agree with sums in f64, also where the mean is large against
+    /// the spread (where E[x^2] - E[x]^2 in f32 would cancel to noise): the variance within
+    /// 0.5% when the spread is 1e-5 of the level (pbrt-v4 keeps its variance in f32 too),
+    /// 0.1% otherwise.
+    #[test]
+    fn pixel_statistics_keep_their_precision() {
+        for (level, spread, tolerance) in [
+            (1000.0f64, 0.01f64, 5e-3),
+            (0.5, 0.4, 1e-3),
+            (1e-3, 1e-3, 1e-3),
+        ] {
+            let mut stats = PixelStats::default();
+            let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+            let n = 10_000;
+            for i in 0..n {
+                // A deterministic, irregular sequence around `level`.
+                let x = (level + spread * ((i as f64 * 0.618_034).fract() - 0.5)) as f32;
+                stats.add(Spectrum::new(x, x, x));
+                sum += f64::from(x);
+                sum_sq += f64::from(x) * f64::from(x);
+            }
+            let mean = sum / n as f64;
+            let var_of_mean = (sum_sq / n as f64 - mean * mean) / (n as f64 - 1.0);
+            let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+            assert!(rel(f64::from(stats.mean().x), mean) < 1e-6, "{level}");
+            assert!(rel(stats.sum()[0], sum) < 1e-6, "{level}");
+            assert!(rel(stats.sum_sq()[0], sum_sq) < 1e-6, "{level}");
+            let v = f64::from(stats.variance_of_mean().x);
+            assert!(
+                rel(v, var_of_mean) < tolerance,
+                "{level}: {v} against {var_of_mean}"
+            );
+        }
+    }
 
     #[test]
     fn integer_rounding_matches_libm() {

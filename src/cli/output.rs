@@ -82,7 +82,7 @@ impl Output {
                 stats
                     .iter()
                     .map(|p| {
-                        let (m, q) = (p.sum, p.sum_sq);
+                        let (m, q) = (p.sum(), p.sum_sq());
                         let s2 = scale * scale;
                         [
                             m[0] * scale,

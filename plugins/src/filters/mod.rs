@@ -145,9 +145,9 @@ pub fn filter_pixel_means(film: &Film, kernel: &dyn FilterKernel) -> Vec<Spectru
                     if s.count == 0 {
                         continue;
                     }
-                    let inv = 1.0 / f64::from(s.count);
-                    for (acc, v) in sum.iter_mut().zip(s.sum) {
-                        *acc += k * v * inv;
+                    let mean = s.mean();
+                    for (acc, v) in sum.iter_mut().zip([mean.x, mean.y, mean.z]) {
+                        *acc += k * f64::from(v);
                     }
                     weight += k;
                 }
