@@ -650,6 +650,14 @@ impl Film {
         self.halves.is_none().then_some(self.sums.as_slice())
     }
 
+    /// Frees the filter-weighted sums (and the streams' films), once the image is made and
+    /// nothing will merge them: they are the largest part of the film (32 bytes a pixel), and
+    /// the output is written after. [`Film::pixels`] and [`Film::weighted_sums`] are then empty.
+    pub fn release_sums(&mut self) {
+        self.sums = Vec::new();
+        self.halves = None;
+    }
+
     /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
     /// `scale` is applied on output, not here).
     pub fn pixels(&self) -> Vec<Spectrum> {
@@ -772,6 +780,22 @@ mod tests {
             let want = ((r * TABLE_SIZE as f32) as usize).min(TABLE_SIZE - 1);
             assert_eq!(table_index(r) as usize, want, "{r}");
         }
+    }
+
+    /// Releasing the sums frees them and keeps the per-pixel statistics the output still reads.
+    #[test]
+    fn released_sums_leave_the_statistics() {
+        let mut f = Film::new(
+            FilmSettings::with_resolution(2, 1),
+            &BoxFilter::new(0.5, 0.5),
+        );
+        f.add_sample(Vec2::new(0.25, 0.5), Spectrum::splat(1.0));
+        f.add_sample(Vec2::new(1.5, 0.5), Spectrum::splat(5.0));
+        let stats = f.pixel_stats().to_vec();
+        f.release_sums();
+        assert_eq!(f.weighted_sums(), Some(&[][..]));
+        assert!(f.pixels().is_empty());
+        assert_eq!(f.pixel_stats(), &stats[..]);
     }
 
     #[test]

@@ -116,6 +116,12 @@ impl Output {
         self.write_image(&image, Vec::new(), spp)
     }
 
+    /// Whether the final file holds the film's sums (a mergeable file): when asked, or when a
+    /// signal stopped a render whose sums can be merged.
+    pub fn writes_sums(&self, signalled: bool) -> bool {
+        self.mergeable || (signalled && self.can_merge)
+    }
+
     /// The final file: `image` (the reconstruction, scaled) and, in an EXR, the channel AOVs;
     /// mergeable when asked or when the render was stopped by a signal and can be merged.
     /// `spp` is what each pixel was planned to get; a halted render records what it reached.
@@ -129,7 +135,7 @@ impl Output {
                 end.features,
             )?);
         }
-        if self.mergeable || (end.signalled && self.can_merge) {
+        if self.writes_sums(end.signalled) {
             let spp = if end.halted {
                 reached_spp(film.pixel_stats())
             } else {

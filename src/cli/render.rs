@@ -535,6 +535,10 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     }
     let fit_partition = plugins.filter.fit_partition();
     let signalled = counts.halted_by == Some(Halt::Signal);
+    if !out.writes_sums(signalled) {
+        // The image is made; the sums would only raise the peak while the file is written.
+        film.release_sums();
+    }
     let end = End {
         spp,
         halted: counts.halted,
