@@ -101,7 +101,9 @@ def v4_work(original, v4):
         depth = found.group(1) if found else "5"
         args += ["--integrator", "path", "--set", f"integrator.maxdepth={depth}"]
         what.append(f"path maxdepth {depth}")
-    strategy = re.compile(r'"string (?:lightsamplestrategy|lightsampler)"\s*\[?\s*"(\w+)"')
+    # Outside comments: "##Integrator ... lightsamplestrategy ..." names nothing.
+    strategy = re.compile(
+        r'^[^#\n]*"string (?:lightsamplestrategy|lightsampler)"\s*\[?\s*"(\w+)"', re.MULTILINE)
     theirs, ours = strategy.search(text), strategy.search(scene)
     if theirs and ours and theirs.group(1) != ours.group(1):
         args += ["--set", f"integrator.lightsamplestrategy={theirs.group(1)}"]
