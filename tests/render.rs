@@ -347,6 +347,7 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("hair.pbrt", "hair", 16),
     ("fourier.pbrt", "fourier", 16),
     ("texture-filtering.pbrt", "texture-filtering", 4),
+    ("environment-map.pbrt", "environment-map", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

@@ -9,7 +9,6 @@ use crate::light_image::LightImage;
 use acr_parser::{Error, ParamList, ParamType, PluginDesc, Result};
 use glam::DMat4;
 use std::path::Path;
-use std::sync::Arc;
 
 impl Builder<'_> {
     pub(super) fn light(
@@ -70,16 +69,16 @@ impl Builder<'_> {
             "infinite" | "exinfinite" => {
                 let l = rgb_param(params, "L", Spectrum::ONE)? * scale;
                 let map = match map_image(p, main_dir)? {
-                    Some((img, _, _)) => Some(EnvMap::new(Arc::new(img))),
+                    Some((img, _, _)) => Some(EnvMap::new(&img)),
                     // pbrt-v3 gives a constant environment a 1x1 map and samples it through
                     // the map's distribution (uniform in (phi, theta), denser at the poles);
                     // doing the same keeps the variance, and the spatial light choice, as
                     // pbrt-v3 has them.
-                    None => Some(EnvMap::new(Arc::new(crate::image_io::RgbImage {
+                    None => Some(EnvMap::new(&crate::image_io::RgbImage {
                         width: 1,
                         height: 1,
                         pixels: vec![Spectrum::ONE],
-                    }))),
+                    })),
                 };
                 Light::Infinite {
                     l,
