@@ -95,8 +95,8 @@ pub struct MotionTransform {
     end: Mat4,
     start_time: f32,
     end_time: f32,
-    parts: Option<[Decomposed; 2]>,
-    rotation: Option<Slerp>,
+    /// When it moves: its two ends decomposed, and the rotation's path between them.
+    parts: Option<([Decomposed; 2], Slerp)>,
 }
 
 impl MotionTransform {
@@ -110,14 +110,13 @@ impl MotionTransform {
             if a.rotation.dot(b.rotation) < 0.0 {
                 b.rotation = -b.rotation;
             }
-            [a, b]
+            ([a, b], Slerp::new(a.rotation, b.rotation))
         });
         Self {
             start: desc.start.as_mat4(),
             end: desc.end.as_mat4(),
             start_time: desc.start_time as f32,
             end_time: desc.end_time as f32,
-            rotation: parts.map(|[a, b]| Slerp::new(a.rotation, b.rotation)),
             parts,
         }
     }
@@ -129,7 +128,7 @@ impl MotionTransform {
 
     /// The transform at `time` (clamped to the start and end).
     pub fn at(&self, time: f32) -> Mat4 {
-        let (Some([a, b]), Some(rotation)) = (&self.parts, &self.rotation) else {
+        let Some(([a, b], rotation)) = &self.parts else {
             return self.start;
         };
         if time <= self.start_time {
@@ -156,7 +155,7 @@ impl MotionTransform {
     /// the box padded by the largest chord-to-arc gap a rotation step can leave.
     pub fn motion_bounds(&self, bounds: (Vec3, Vec3)) -> (Vec3, Vec3) {
         let corners = corners(bounds);
-        let Some([a, b]) = &self.parts else {
+        let Some(([a, b], _)) = &self.parts else {
             return transform_box(&self.start, &corners);
         };
         const STEPS: usize = 128;

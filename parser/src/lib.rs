@@ -17,7 +17,7 @@ pub mod transform;
 pub use error::{Error, Result, Warning};
 pub use mesh::Mesh;
 pub use params::{Param, ParamList, ParamType, TextureRef, Values};
-pub use parser::{closest, io_message, parse_file, parse_str};
+pub use parser::{closest, io_message, parse_file, parse_str, resolve_path};
 pub use scene::{
     CameraDesc, InstanceDesc, LightDesc, MaterialDesc, ObjectDesc, PluginDesc, SceneDescription,
     ShapeDesc, TextureDesc, TextureValue,

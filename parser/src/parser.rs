@@ -112,7 +112,7 @@ pub fn io_message(e: &std::io::Error) -> String {
 
 /// Resolves a file name written in a scene: relative to the file that names it, and failing
 /// that relative to the main scene file's directory (pbrt-v3's rule), so both layouts work.
-pub(crate) fn resolve_path(name: &str, including: &SourceFile, base_dir: &Path) -> PathBuf {
+pub fn resolve_path(name: &str, including: &SourceFile, base_dir: &Path) -> PathBuf {
     let p = Path::new(name);
     if p.is_absolute() {
         return p.to_path_buf();

@@ -27,6 +27,24 @@ fn specular_refraction(wo: Vec3, eta_a: f32, eta_b: f32) -> Option<(Vec3, f32)> 
     Some((wi, (eta_i * eta_i) / (eta_t * eta_t)))
 }
 
+/// pbrt-v3's generalised half vector of a refraction from local `wo` to `wi` across the
+/// boundary between `eta_a` (the normal's side) and `eta_b`, faced to +z, with the relative
+/// index eta it was made with; `None` when it is degenerate or `wo` and `wi` lie on the same
+/// side of it (not a refraction). The transmission's value and density share it.
+fn refraction_half_vector(wo: Vec3, wi: Vec3, eta_a: f32, eta_b: f32) -> Option<(Vec3, f32)> {
+    let eta = if cos_theta(wo) > 0.0 {
+        eta_b / eta_a
+    } else {
+        eta_a / eta_b
+    };
+    let wh = (wo + wi * eta).try_normalize()?;
+    let wh = if wh.z < 0.0 { -wh } else { wh };
+    if wo.dot(wh) * wi.dot(wh) > 0.0 {
+        return None;
+    }
+    Some((wh, eta))
+}
+
 /// Samples a microfacet normal of `distribution` for local `wo` and reflects `wo` about it
 /// (pbrt-v3's `MicrofacetReflection::Sample_f`): the direction and its density, from the
 /// sampled normal's (not recomputed from the direction). `None` when `wo` is grazing, the
@@ -281,21 +299,9 @@ impl Bxdf {
                 if cos_i == 0.0 || cos_o == 0.0 {
                     return Spectrum::ZERO;
                 }
-                let eta = if cos_o > 0.0 {
-                    eta_b / eta_a
-                } else {
-                    eta_a / eta_b
-                };
-                let Some(mut wh) = (wo + wi * eta).try_normalize() else {
+                let Some((wh, eta)) = refraction_half_vector(wo, wi, eta_a, eta_b) else {
                     return Spectrum::ZERO;
                 };
-                if wh.z < 0.0 {
-                    wh = -wh;
-                }
-                // Same side of the microfacet: not a refraction.
-                if wo.dot(wh) * wi.dot(wh) > 0.0 {
-                    return Spectrum::ZERO;
-                }
                 let fr = fr_dielectric(wo.dot(wh), eta_a, eta_b);
                 let sqrt_denom = wo.dot(wh) + eta * wi.dot(wh);
                 if sqrt_denom == 0.0 {
@@ -535,17 +541,10 @@ impl Bxdf {
                 if same_hemisphere(wo, wi) {
                     return 0.0;
                 }
-                let eta = if cos_theta(wo) > 0.0 {
-                    eta_b / eta_a
-                } else {
-                    eta_a / eta_b
-                };
-                let Some(wh) = (wo + wi * eta).try_normalize() else {
+                // The half vector faced to +z: the density is the same for either side.
+                let Some((wh, eta)) = refraction_half_vector(wo, wi, eta_a, eta_b) else {
                     return 0.0;
                 };
-                if wo.dot(wh) * wi.dot(wh) > 0.0 {
-                    return 0.0;
-                }
                 let sqrt_denom = wo.dot(wh) + eta * wi.dot(wh);
                 let dwh_dwi = ((eta * eta * wi.dot(wh)) / (sqrt_denom * sqrt_denom)).abs();
                 distribution.pdf(wo, wh) * dwh_dwi

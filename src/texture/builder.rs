@@ -4,7 +4,9 @@ use crate::geometry::Spectrum;
 use crate::image_io::{read_image, RgbImage};
 use crate::mipmap::MipMap;
 use crate::procedural::NoisePattern;
-use acr_parser::{Error, Loc, ParamList, Result, SceneDescription, TextureValue, Values, Warning};
+use acr_parser::{
+    Error, Loc, ParamList, Result, SceneDescription, TextureRef, TextureValue, Values, Warning,
+};
 use glam::{DMat4, Mat4};
 use std::collections::{HashMap, HashSet};
 use std::fmt::Debug;
@@ -105,11 +107,12 @@ pub struct TextureBuilder<'a> {
 trait Build: TexValue {
     fn cache<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut Vec<Option<Arc<Texture<Self>>>>;
     fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<MipMap<Self>>>;
-    fn param(
-        b: &mut TextureBuilder<'_>,
-        params: &ParamList,
-        name: &str,
-    ) -> Result<Option<Texture<Self>>>;
+    /// The texture of this value type that a `"texture"` parameter names, if there is one.
+    fn index(t: &TextureRef) -> Option<usize>;
+    /// The parameter as a constant of this value type, if written as one.
+    fn value(params: &ParamList, name: &str) -> Result<Option<Self>>;
+    /// The value type's name in messages.
+    const NAME: &'static str;
     fn kind() -> TextureValue;
 }
 
@@ -120,13 +123,13 @@ impl Build for f32 {
     fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<MipMap<Self>>> {
         &mut b.float_maps
     }
-    fn param(
-        b: &mut TextureBuilder<'_>,
-        params: &ParamList,
-        name: &str,
-    ) -> Result<Option<Texture<Self>>> {
-        b.float_param_opt(params, name)
+    fn index(t: &TextureRef) -> Option<usize> {
+        t.float
     }
+    fn value(params: &ParamList, name: &str) -> Result<Option<Self>> {
+        float_value(params, name)
+    }
+    const NAME: &'static str = "float";
     fn kind() -> TextureValue {
         TextureValue::Float
     }
@@ -139,13 +142,13 @@ impl Build for Spectrum {
     fn maps<'b>(b: &'b mut TextureBuilder<'_>) -> &'b mut HashMap<ImageKey, Arc<MipMap<Self>>> {
         &mut b.spectrum_maps
     }
-    fn param(
-        b: &mut TextureBuilder<'_>,
-        params: &ParamList,
-        name: &str,
-    ) -> Result<Option<Texture<Self>>> {
-        b.spectrum_param_opt(params, name)
+    fn index(t: &TextureRef) -> Option<usize> {
+        t.spectrum
     }
+    fn value(params: &ParamList, name: &str) -> Result<Option<Self>> {
+        spectrum_value(params, name)
+    }
+    const NAME: &'static str = "spectrum";
     fn kind() -> TextureValue {
         TextureValue::Spectrum
     }
@@ -229,28 +232,7 @@ impl<'a> TextureBuilder<'a> {
         params: &ParamList,
         name: &str,
     ) -> Result<Option<FloatTexture>> {
-        let Some(p) = find(params, name) else {
-            return Ok(None);
-        };
-        if let Values::Texture(t) = &p.values {
-            p.mark_used();
-            return match t.float {
-                Some(i) => Ok(Some((*self.float_texture(i)?).clone())),
-                None => {
-                    self.warn_once(
-                        format!("texture kind {}", t.name),
-                        &p.loc,
-                        format!(
-                            "\"{}\" is not a float texture, as parameter \"{name}\" needs; \
-                             its default is used",
-                            t.name
-                        ),
-                    );
-                    Ok(None)
-                }
-            };
-        }
-        Ok(float_value(params, name)?.map(Texture::Constant))
+        self.param_opt(params, name)
     }
 
     /// [`TextureBuilder::float_param_opt`] with a default.
@@ -273,28 +255,40 @@ impl<'a> TextureBuilder<'a> {
         params: &ParamList,
         name: &str,
     ) -> Result<Option<SpectrumTexture>> {
+        self.param_opt(params, name)
+    }
+
+    /// A material parameter as a texture of value type `T`: a `"texture"` reference to such a
+    /// texture, or a constant of that type; `None` when absent (or of another type, which is
+    /// left unused).
+    fn param_opt<T: Build>(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+    ) -> Result<Option<Texture<T>>> {
         let Some(p) = find(params, name) else {
             return Ok(None);
         };
         if let Values::Texture(t) = &p.values {
             p.mark_used();
-            return match t.spectrum {
-                Some(i) => Ok(Some((*self.spectrum_texture(i)?).clone())),
+            return match T::index(t) {
+                Some(i) => Ok(Some((*self.texture::<T>(i)?).clone())),
                 None => {
                     self.warn_once(
                         format!("texture kind {}", t.name),
                         &p.loc,
                         format!(
-                            "\"{}\" is not a spectrum texture, as parameter \"{name}\" needs; \
+                            "\"{}\" is not a {} texture, as parameter \"{name}\" needs; \
                              its default is used",
-                            t.name
+                            t.name,
+                            T::NAME
                         ),
                     );
                     Ok(None)
                 }
             };
         }
-        Ok(spectrum_value(params, name)?.map(Texture::Constant))
+        Ok(T::value(params, name)?.map(Texture::Constant))
     }
 
     /// [`TextureBuilder::spectrum_param_opt`] with a default.
@@ -316,7 +310,8 @@ impl<'a> TextureBuilder<'a> {
         default: T,
     ) -> Result<Arc<Texture<T>>> {
         Ok(Arc::new(
-            T::param(self, params, name)?.unwrap_or(Texture::Constant(default)),
+            self.param_opt::<T>(params, name)?
+                .unwrap_or(Texture::Constant(default)),
         ))
     }
 
@@ -355,7 +350,7 @@ impl<'a> TextureBuilder<'a> {
         let loc = &td.plugin.loc;
         let tex = match td.plugin.kind.as_str() {
             "constant" => Texture::Constant(
-                T::param(self, p, "value")?
+                self.param_opt::<T>(p, "value")?
                     .and_then(|t| t.as_constant())
                     .unwrap_or(T::ONE),
             ),
@@ -435,7 +430,7 @@ impl<'a> TextureBuilder<'a> {
                 )?;
                 let mut v = [T::ZERO, T::ONE, T::ZERO, T::ONE];
                 for (slot, name) in v.iter_mut().zip(["v00", "v01", "v10", "v11"]) {
-                    if let Some(c) = T::param(self, p, name)?.and_then(|t| t.as_constant()) {
+                    if let Some(c) = self.param_opt::<T>(p, name)?.and_then(|t| t.as_constant()) {
                         *slot = c;
                     }
                 }

@@ -327,20 +327,7 @@ impl<T: TexValue> Texture<T> {
 /// main scene file's directory `main_dir`. When neither exists, the first candidate is returned
 /// so that the error names it.
 pub fn resolve_file(name: &str, loc: &Loc, main_dir: &Path) -> PathBuf {
-    let p = Path::new(name);
-    if p.is_absolute() {
-        return p.to_path_buf();
-    }
-    let local = loc.file.dir().join(p);
-    if local.exists() {
-        return local;
-    }
-    let main = main_dir.join(p);
-    if main.exists() {
-        main
-    } else {
-        local
-    }
+    acr_parser::resolve_path(name, &loc.file, main_dir)
 }
 
 /// The parameter of that name, without marking it used.
