@@ -1,0 +1,83 @@
+//! Renders that stop early: the noise threshold and the time limit.
+
+use super::*;
+
+/// `--noise-threshold`: a loose threshold stops at `--min-spp` (plus the pass under way), with
+/// every pixel at the same count, for every kind of sampler; a tighter one takes more samples
+/// and ends with a lower error; one that is never met leaves the budget to `--spp`.
+#[test]
+fn a_noise_threshold_stops_early_keeps_min_spp_and_spp_caps_it() {
+    let dir = TempDir::new("noise");
+    // 40,000 pixels: more than a batch, so that a pass is one sample per pixel.
+    let scene = dir.write("n.pbrt", &example_scene("cornell-box.pbrt", 200, 200));
+    let pixels = 200 * 200;
+    let run = |sampler: &str, args: &[&str]| {
+        let (out, stats) = (dir.join(format!("{sampler}.exr")), dir.join("n.json"));
+        let mut all = vec!["--sampler", sampler, "--seed", "1", "--stats"];
+        all.push(stats.to_str().unwrap());
+        all.extend_from_slice(args);
+        render_ok(&scene, &out, &all);
+        read_stats(&stats)
+    };
+    for sampler in ["stratified", "sobol", "random", "cluster"] {
+        let s = run(
+            sampler,
+            &["--spp", "64", "--noise-threshold", "1e6", "--min-spp", "6"],
+        );
+        let spp = s["samples"].as_u64().unwrap() as f64 / pixels as f64;
+        assert!((6.0..=7.0).contains(&spp), "{sampler}: {spp} spp");
+        assert_eq!(s["halted"], true, "{sampler}");
+        assert_eq!(s["halted_by"], "noise", "{sampler}");
+    }
+    // Tighter thresholds: more samples, and the error they stop at is below the threshold.
+    let spp_at = |t: &str| {
+        let s = run("stratified", &["--spp", "1024", "--noise-threshold", t]);
+        s["samples"].as_u64().unwrap() / pixels
+    };
+    let (loose, tight) = (spp_at("0.3"), spp_at("0.1"));
+    assert!(loose < tight && tight < 1024, "{loose} then {tight} spp");
+    // Never met: the budget caps it, and nothing says it halted.
+    let s = run("stratified", &["--spp", "8", "--noise-threshold", "1e-9"]);
+    assert_eq!(s["samples"].as_u64().unwrap(), 8 * pixels);
+    assert_eq!(s["halted"], false);
+    assert!(s["halted_by"].is_null());
+}
+
+#[test]
+fn a_time_limit_stops_at_a_whole_pass_and_the_image_stays_complete() {
+    let dir = TempDir::new("timelimit");
+    let scene = dir.write("slow.pbrt", &example_scene("cornell-box.pbrt", 200, 200));
+    let (out, stats, spp_aov) = (dir.join("t.exr"), dir.join("t.json"), dir.join("spp.exr"));
+    let mut cmd = acr_command([
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--spp",
+        "100000",
+        "--time-limit",
+        "0.5",
+        "--stats",
+        stats.to_str().unwrap(),
+        "--aov",
+        &format!("spp={}", spp_aov.display()),
+    ]);
+    cmd.stderr(Stdio::piped()).stdout(Stdio::piped());
+    let o = output_within(cmd, Duration::from_secs(60));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = read_stats(&stats);
+    assert_eq!(s["halted"], true);
+    assert_eq!(s["halted_by"], "time");
+    let samples = s["samples"].as_u64().unwrap();
+    assert!(samples > 0 && samples < 100_000 * 200 * 200);
+    // Whole passes: every pixel has the same count, and the image has no hole.
+    let counts = read_image(&spp_aov, false).unwrap();
+    let first = counts.pixels[0].x;
+    assert!(first >= 1.0);
+    assert!(counts.pixels.iter().all(|c| c.x == first));
+    assert_eq!(first as u64 * 200 * 200, samples);
+    let img = read_image(&out, false).unwrap();
+    let lit = img.pixels.iter().filter(|c| c.max_element() > 0.0).count();
+    assert!(lit > 200 * 200 * 9 / 10, "{lit} lit pixels");
+}
