@@ -431,6 +431,9 @@ pub fn render_with(
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
     if !counts.halted {
         counts.halted_by = None;
+    } else if counts.halted_by.is_none() && stop.noise_threshold.is_some() {
+        // A sampler that stops where it is settled ended by itself, everywhere settled.
+        counts.halted_by = Some(Halt::Noise);
     }
     counts.sampler_seconds = in_sampler.as_secs_f64();
     counts

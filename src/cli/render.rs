@@ -422,6 +422,11 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         b
     });
     let spp = plugins.sampler.spp();
+    if let Some(t) = args.noise_threshold {
+        // An adaptive sampler that can stops where it is settled; the render loop's global
+        // check stops any sampler.
+        plugins.sampler.stop_at_noise(t, args.min_spp);
+    }
     let mut recording = Recording::new(plugins.sampler.as_mut());
     let sampler: &mut dyn Sampler = if args.sampler_cost {
         &mut recording

@@ -4,7 +4,8 @@ use super::*;
 
 /// `--noise-threshold`: a loose threshold stops at `--min-spp` (plus the pass under way), with
 /// every pixel at the same count, for every kind of sampler; a tighter one takes more samples
-/// and ends with a lower error; one that is never met leaves the budget to `--spp`.
+/// and ends with a lower error; the cluster sampler adapts before it stops; one that is never
+/// met leaves the budget to `--spp`.
 #[test]
 fn a_noise_threshold_stops_early_keeps_min_spp_and_spp_caps_it() {
     let dir = TempDir::new("noise");
@@ -36,6 +37,22 @@ fn a_noise_threshold_stops_early_keeps_min_spp_and_spp_caps_it() {
     };
     let (loose, tight) = (spp_at("0.3"), spp_at("0.1"));
     assert!(loose < tight && tight < 1024, "{loose} then {tight} spp");
+    // The cluster sampler adapts toward the threshold: its first stage is --min-spp (not a
+    // quarter of --spp), and it has planned rounds by the time the threshold stops it.
+    let s = run(
+        "cluster",
+        &[
+            "--spp",
+            "1024",
+            "--noise-threshold",
+            "0.1",
+            "--min-spp",
+            "4",
+        ],
+    );
+    assert_eq!(s["halted_by"], "noise");
+    assert!(s["rounds"].as_u64().unwrap() > 0, "{}", s["rounds"]);
+    assert!(s["samples"].as_u64().unwrap() < 1024 * pixels);
     // Never met: the budget caps it, and nothing says it halted.
     let s = run("stratified", &["--spp", "8", "--noise-threshold", "1e-9"]);
     assert_eq!(s["samples"].as_u64().unwrap(), 8 * pixels);

@@ -76,6 +76,15 @@ pub trait Sampler: Send {
     /// pixel has as many samples as the others (at least one pass), then gives no more.
     fn halt(&mut self);
 
+    /// Asks the sampler to stop sampling where its own estimate of the relative error is below
+    /// `threshold` once every cell there has `min_spp` samples, and to end when that holds
+    /// everywhere (`--noise-threshold`); says whether it does. By default it does not, and the
+    /// render loop stops it as a whole.
+    fn stop_at_noise(&mut self, threshold: f64, min_spp: u32) -> bool {
+        let _ = (threshold, min_spp);
+        false
+    }
+
     /// Whether the next batch may be asked for before the last one is observed (so that it is
     /// planned while that one is traced); the order of calls is the same whatever the timing.
     fn plans_ahead(&self) -> bool {

@@ -114,6 +114,9 @@ pub struct ClusterSampler {
     changes: Vec<Change>,
     rounds: u64,
     partition: Option<Partition>,
+    /// With `--noise-threshold`: the threshold, and the samples each cell of a cluster needs
+    /// before the cluster may settle.
+    noise: Option<(f64, u32)>,
 }
 
 impl ClusterSampler {
@@ -163,6 +166,7 @@ impl ClusterSampler {
             changes: Vec::new(),
             rounds: 0,
             partition: None,
+            noise: None,
         }
     }
 
@@ -232,6 +236,25 @@ impl ClusterSampler {
         Some((self.priority(&e), e))
     }
 
+    /// The relative error of cluster `id`, as `--noise-threshold` defines it for an image:
+    /// the mean over its cells of the standard error of the cell's mean luminance over
+    /// (that mean + 0.01). Infinite while a cell has fewer than `least` samples (or two).
+    fn relative_error(&self, id: u32, least: u32) -> f64 {
+        let clustering = self.clustering.as_ref().expect("clustered");
+        let cells = &clustering.clusters[id as usize].cells;
+        let mut total = 0.0;
+        for &c in cells {
+            let c = c as usize;
+            let n = self.sums.count[c];
+            if n < least.max(2) {
+                return f64::INFINITY;
+            }
+            let mean = self.sums.mean(c).unwrap_or(0.0).max(0.0);
+            total += (self.sums.variance(c) / f64::from(n)).sqrt() / (mean + 0.01);
+        }
+        total / cells.len().max(1) as f64
+    }
+
     /// Queues the clusters `ids` in the order given.
     fn push_all(&mut self, ids: impl IntoIterator<Item = u32>) {
         for id in ids {
@@ -277,6 +300,11 @@ impl ClusterSampler {
             // A live entry's cluster has cells: a cluster that loses its last one changes
             // version.
             if self.version[top.id as usize] != top.version {
+                continue;
+            }
+            // A settled cluster leaves the queue; a move into or out of it queues it again.
+            let settled = |(t, least)| self.relative_error(top.id, least) < t;
+            if self.settings.settle && self.noise.is_some_and(settled) {
                 continue;
             }
             let k = u64::from(top.cells)
@@ -759,6 +787,22 @@ impl Sampler for ClusterSampler {
     fn halt(&mut self) {
         self.halted = true;
         self.init.halt();
+    }
+
+    fn stop_at_noise(&mut self, threshold: f64, min_spp: u32) -> bool {
+        self.noise = Some((threshold, min_spp));
+        // Before the first batch, the first stage shrinks to what every pixel must have
+        // (Cycles' adaptive_min_samples), so that the threshold steers the rest; planned for
+        // the whole budget, it would spend a quarter of it before adapting.
+        let unstarted = self.phase == Phase::Init && self.pixel_count.iter().all(|&n| n == 0);
+        if unstarted && !self.settings.init_given {
+            let s = &mut self.settings;
+            s.init_spp = s.init_spp.min(min_spp.max(s.min_spp)).clamp(1, s.spp);
+            self.init =
+                SobolSampler::new(self.space, s.init_spp, self.seed ^ SALT).with_stream(s.stream);
+            self.remaining = self.space.pixels() * u64::from(s.spp - s.init_spp);
+        }
+        true
     }
 
     fn plans_ahead(&self) -> bool {

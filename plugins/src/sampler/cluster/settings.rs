@@ -54,6 +54,11 @@ pub struct ClusterSettings {
     pub keep_radiance: bool,
     /// Which interleaved stream of sample indices it gives (see [`IndexStream`]).
     pub stream: IndexStream,
+    /// Whether `init_spp` was given (then `--noise-threshold` keeps it).
+    pub init_given: bool,
+    /// With `--noise-threshold`, a cluster whose own relative error is below the threshold
+    /// leaves the queue (measured: more error per sample than letting the priority run).
+    pub settle: bool,
 }
 
 impl ClusterSettings {
@@ -87,6 +92,8 @@ impl ClusterSettings {
             log_features: true,
             keep_radiance: true,
             stream: IndexStream::ALL,
+            init_given: false,
+            settle: false,
         }
     }
 
@@ -194,6 +201,14 @@ pub(in crate::sampler) const ENTRY: Entry<SamplerBuild> = Entry {
                 "persample",
                 "which clusters get samples: persample (err x cells / samples) or paper (err)",
             ),
+            ParamSpec::new(
+                "settle",
+                ParamType::Bool,
+                "false",
+                "with --noise-threshold, a cluster whose own relative error is below the \
+                 threshold gets no more samples (measured: more error per sample than leaving \
+                 it to the priority; see the README)",
+            ),
             crate::sampler::paired::STREAMS,
         ],
     },
@@ -218,6 +233,8 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
     s.bins = int_in(p, "bins", s.bins as i32, 1..=16)?;
     let max = i64::from(spp);
     s.init_spp = int_in(p, "initspp", s.init_spp as i32, 1..=max)?;
+    s.init_given = p.get("initspp").is_some();
+    s.settle = p.bool_or("settle", s.settle)?;
     s.min_spp = int_in(p, "minspp", s.min_spp as i32, 0..=max)?;
     s.max_cluster_cells = int_in(
         p,
