@@ -9,6 +9,7 @@ pub mod filters;
 pub mod first_hit;
 pub mod kernel;
 pub mod partition;
+pub mod prefilter;
 pub mod registry;
 pub mod regression;
 pub mod rng;

@@ -382,6 +382,7 @@ struct Band<'a> {
     offset: &'a mut [f32],
     offset_sq: &'a mut [f32],
     features: &'a mut [Features],
+    albedo_sq: &'a mut [[f32; 3]],
     dims: usize,
 }
 
@@ -394,6 +395,9 @@ impl Band<'_> {
         if let (Some(sum), Some(f)) = (self.features.get_mut(i), f) {
             for (s, v) in sum.iter_mut().zip(f) {
                 *s += v;
+            }
+            for (s, v) in self.albedo_sq[i].iter_mut().zip(f) {
+                *s += v * v;
             }
         }
         let y = f64::from(luminance(l));
@@ -439,6 +443,9 @@ pub struct CellSums {
     pub offset_sq: Vec<f32>,
     /// Sum of the samples' first-hit features; empty unless made [`CellSums::with_features`].
     pub features: Vec<Features>,
+    /// Sum of the squares of the samples' first-hit albedo, beside `features`: the albedo's
+    /// own noise, for the fit's feature prefilter.
+    pub albedo_sq: Vec<[f32; 3]>,
     dims: usize,
 }
 
@@ -470,6 +477,7 @@ impl CellSums {
             offset: Vec::new(),
             offset_sq: Vec::new(),
             features: Vec::new(),
+            albedo_sq: Vec::new(),
             dims: grid.dims(),
         }
     }
@@ -477,6 +485,7 @@ impl CellSums {
     /// These sums, also keeping each cell's sum of first-hit features.
     pub fn with_features(mut self) -> Self {
         self.features = vec![[0.0; crate::first_hit::FEATURES]; self.count.len()];
+        self.albedo_sq = vec![[0.0; 3]; self.count.len()];
         self
     }
 
@@ -569,7 +578,8 @@ impl CellSums {
             lum_sq: &mut self.lum_sq[start..end],
             offset: &mut self.offset[o.clone()],
             offset_sq: &mut self.offset_sq[o],
-            features: &mut self.features[f],
+            features: &mut self.features[f.clone()],
+            albedo_sq: &mut self.albedo_sq[f],
             dims: d,
         }
     }
@@ -591,8 +601,12 @@ impl CellSums {
             .zip(chunks(&mut self.offset, band_len * d))
             .zip(chunks(&mut self.offset_sq, band_len * d))
             .zip(chunks(&mut self.features, band_len))
+            .zip(chunks(&mut self.albedo_sq, band_len))
             .map(
-                |(((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq), features)| Band {
+                |(
+                    (((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq), features),
+                    albedo_sq,
+                )| Band {
                     count,
                     rgb,
                     rgb_sq,
@@ -601,6 +615,7 @@ impl CellSums {
                     offset,
                     offset_sq,
                     features,
+                    albedo_sq,
                     dims: d,
                 },
             )
@@ -634,6 +649,7 @@ impl CellSums {
             + self.offset.capacity() * 4
             + self.offset_sq.capacity() * 4
             + self.features.capacity() * std::mem::size_of::<Features>()
+            + self.albedo_sq.capacity() * 12
     }
 
     /// Active dims (offsets per cell).
