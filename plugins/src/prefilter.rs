@@ -102,7 +102,7 @@ pub fn prefilter_albedo(grid: &CellGrid, sums: &CellSums, radius: u32, kappa: f6
                                 / (SHADING_SCALE * SHADING_SCALE))
                                 .exp()
                     };
-                    if !(weight > 0.0) {
+                    if weight.is_nan() || weight <= 0.0 {
                         continue;
                     }
                     for c in 0..3 {
