@@ -6,7 +6,7 @@
 //! a noisy albedo loses its noise, and a precise one (its samples agree) is left alone.
 
 use crate::cluster::{CellGrid, CellSums};
-use crate::first_hit::{DEPTH, FEATURES, NORMAL};
+use crate::first_hit::{Features, DEPTH, FEATURES, NORMAL};
 use rayon::prelude::*;
 
 /// Depth difference, relative to the larger depth, at which a neighbour's weight is 1/e.
@@ -44,10 +44,10 @@ fn albedo_variance(sums: &CellSums, i: usize) -> f64 {
     v / 3.0
 }
 
-/// The weight of neighbour features `fj` for a cell of features `fi`, apart from counts and
-/// shading: depth and normal agreement, and NL-means on the albedo with `v` the two cells'
-/// albedo variances of the mean summed (0: only an equal albedo agrees).
-fn similarity(fi: &[f64; FEATURES], fj: &[f64; FEATURES], v: f64, kappa: f64) -> f64 {
+/// The logarithm of the weight of neighbour features `fj` for a cell of features `fi`, apart
+/// from counts and shading: depth and normal agreement, and NL-means on the albedo with `v`
+/// the two cells' albedo variances of the mean summed (0: only an equal albedo agrees).
+fn log_similarity(fi: &[f64; FEATURES], fj: &[f64; FEATURES], v: f64, kappa: f64) -> f64 {
     let larger = fi[DEPTH].abs().max(fj[DEPTH].abs()).max(1e-6);
     let dd = (fi[DEPTH] - fj[DEPTH]) / (DEPTH_SCALE * larger);
     let dn: f64 = (NORMAL..NORMAL + 3).map(|c| (fi[c] - fj[c]).powi(2)).sum();
@@ -59,66 +59,72 @@ fn similarity(fi: &[f64; FEATURES], fj: &[f64; FEATURES], v: f64, kappa: f64) ->
     } else {
         0.0
     };
-    (-dd * dd - dn / (NORMAL_SCALE * NORMAL_SCALE) + albedo).exp()
+    -dd * dd - dn / (NORMAL_SCALE * NORMAL_SCALE) + albedo
 }
 
-/// `sums` with each cell's albedo sum replaced by its count times the weighted mean albedo of
+/// The feature sums of `sums` with each cell's albedo sum replaced by its count times the weighted mean albedo of
 /// the cells within `radius` image cells (the same time and lens bins), weighted by count,
 /// depth and normal agreement and NL-means on the albedo itself: a neighbour whose mean albedo
 /// differs by d (squared, over the channels) from the cell's weighs
 /// exp(-max(0, d - v) / (kappa^2 v)), v the two cells' albedo variances of the mean summed.
 /// Sums without features or radiance, or a radius of 0, are returned unchanged.
-pub fn prefilter_albedo(grid: &CellGrid, sums: &CellSums, radius: u32, kappa: f64) -> CellSums {
-    let mut out = sums.clone();
+pub fn prefilter_albedo(
+    grid: &CellGrid,
+    sums: &CellSums,
+    radius: u32,
+    kappa: f64,
+) -> Vec<Features> {
+    let mut out = sums.features.clone();
     if radius == 0 || !sums.keeps_features() || sums.rgb.is_empty() {
         return out;
     }
     let shape = grid.shape();
     let (w, h) = (i64::from(shape[0]), i64::from(shape[1]));
     let inner = grid.cells_per_image_cell();
-    let means: Vec<_> = (0..grid.len()).map(|i| sums.mean_features(i)).collect();
-    let variance: Vec<f64> = (0..grid.len()).map(|i| albedo_variance(sums, i)).collect();
-    let shading: Vec<f64> = (0..grid.len())
-        .map(|i| means[i].map_or(1.0, |f| shading(sums, i, &f)))
-        .collect();
-    let r = i64::from(radius);
-    let filtered: Vec<Option<[f32; 3]>> = (0..grid.len())
+    // Per cell: its albedo's variance of the mean and the logarithm of its shading.
+    let stats: Vec<[f64; 2]> = (0..grid.len())
         .into_par_iter()
         .map(|i| {
-            let fi = means[i].as_ref()?;
-            let (image_cell, k) = (i / inner, i % inner);
-            let (cx, cy) = ((image_cell as i64) % w, (image_cell as i64) / w);
-            let (mut acc, mut total) = ([0.0f64; 3], 0.0f64);
-            for y in (cy - r).max(0)..=(cy + r).min(h - 1) {
-                for x in (cx - r).max(0)..=(cx + r).min(w - 1) {
-                    let j = (y * w + x) as usize * inner + k;
-                    let Some(fj) = &means[j] else { continue };
-                    let weight = if j == i {
-                        f64::from(sums.count[j])
-                    } else {
-                        f64::from(sums.count[j])
-                            * similarity(fi, fj, variance[i] + variance[j], kappa)
-                            * (-(shading[i] / shading[j]).ln().powi(2)
-                                / (SHADING_SCALE * SHADING_SCALE))
-                                .exp()
-                    };
-                    if weight.is_nan() || weight <= 0.0 {
-                        continue;
-                    }
-                    for c in 0..3 {
-                        acc[c] += weight * fj[c];
-                    }
-                    total += weight;
-                }
-            }
-            let n = f64::from(sums.count[i]);
-            Some(acc.map(|a| (a / total * n) as f32))
+            let log_shading = sums
+                .mean_features(i)
+                .map_or(0.0, |f| shading(sums, i, &f).ln());
+            [albedo_variance(sums, i), log_shading]
         })
         .collect();
-    for (i, f) in filtered.into_iter().enumerate() {
-        if let Some(f) = f {
-            out.features[i][..3].copy_from_slice(&f);
+    let r = i64::from(radius);
+    out.par_iter_mut().enumerate().for_each(|(i, slot)| {
+        let Some(fi) = sums.mean_features(i) else {
+            return;
+        };
+        let (image_cell, k) = (i / inner, i % inner);
+        let (cx, cy) = ((image_cell as i64) % w, (image_cell as i64) / w);
+        let (mut acc, mut total) = ([0.0f64; 3], 0.0f64);
+        for y in (cy - r).max(0)..=(cy + r).min(h - 1) {
+            for x in (cx - r).max(0)..=(cx + r).min(w - 1) {
+                let j = (y * w + x) as usize * inner + k;
+                let Some(fj) = sums.mean_features(j) else {
+                    continue;
+                };
+                let weight = if j == i {
+                    f64::from(sums.count[j])
+                } else {
+                    let ds = (stats[i][1] - stats[j][1]) / SHADING_SCALE;
+                    let log = log_similarity(&fi, &fj, stats[i][0] + stats[j][0], kappa);
+                    f64::from(sums.count[j]) * (log - ds * ds).exp()
+                };
+                if weight.is_nan() || weight <= 0.0 {
+                    continue;
+                }
+                for c in 0..3 {
+                    acc[c] += weight * fj[c];
+                }
+                total += weight;
+            }
         }
-    }
+        let n = f64::from(sums.count[i]);
+        for c in 0..3 {
+            slot[c] = (acc[c] / total * n) as f32;
+        }
+    });
     out
 }

@@ -9,7 +9,7 @@
 //! scenes: 1.6x the MSE on motion blur at 8 spp.)
 
 use super::{CellGrid, CellSums};
-use crate::first_hit::{agree, FEATURES};
+use crate::first_hit::{agree, Features, FEATURES};
 
 /// A partition of the cells: each cell's cluster and each cluster's cells.
 #[derive(Clone, Debug, Default)]
@@ -83,6 +83,18 @@ pub fn grow_by_noise(
     z: f64,
     feature_tolerance: Option<f64>,
 ) -> NoiseClusters {
+    grow_by_noise_with(grid, sums, &sums.features, z, feature_tolerance)
+}
+
+/// [`grow_by_noise`] with feature sums `features` in place of the cells' own (a prefiltered
+/// copy, cell for cell).
+pub fn grow_by_noise_with(
+    grid: &CellGrid,
+    sums: &CellSums,
+    features: &[Features],
+    z: f64,
+    feature_tolerance: Option<f64>,
+) -> NoiseClusters {
     let n = grid.len();
     let tolerance = feature_tolerance.filter(|_| sums.keeps_features());
     let moments: Vec<Moments> = (0..n)
@@ -90,8 +102,7 @@ pub fn grow_by_noise(
             n: f64::from(sums.count[i]),
             sum: sums.lum[i],
             sum_sq: sums.lum_sq[i],
-            features: sums
-                .features
+            features: features
                 .get(i)
                 .map_or([0.0; FEATURES], |f| f.map(f64::from)),
         })

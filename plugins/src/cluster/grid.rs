@@ -494,6 +494,18 @@ impl CellSums {
         !self.features.is_empty()
     }
 
+    /// The mean first-hit features of cell `i` from feature sums `features` in place of the
+    /// cells' own (a prefiltered copy); None without samples or without features.
+    pub fn mean_features_of(
+        &self,
+        features: &[Features],
+        i: usize,
+    ) -> Option<[f64; crate::first_hit::FEATURES]> {
+        let n = *self.count.get(i)?;
+        let f = features.get(i)?;
+        (n > 0).then(|| f.map(|v| f64::from(v) / f64::from(n)))
+    }
+
     /// The mean first-hit features of cell `i`; None without samples or without features.
     pub fn mean_features(&self, i: usize) -> Option<[f64; crate::first_hit::FEATURES]> {
         let n = *self.count.get(i)?;

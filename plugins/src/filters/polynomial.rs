@@ -13,10 +13,11 @@
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
 use crate::cluster::build::{initial_clustering, Initial};
-use crate::cluster::by_noise::{grow_by_noise, NoiseClusters};
+use crate::cluster::by_noise::{grow_by_noise_with, NoiseClusters};
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
+use crate::first_hit::Features;
 use crate::partition::Partition;
 use crate::prefilter::prefilter_albedo;
 use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
@@ -142,13 +143,15 @@ impl PolynomialFilter {
     fn reconstruct_cells(&self, film: &Film, view: CellView<'_>) -> Vec<Spectrum> {
         let grid = view.grid;
         let (radius, kappa) = self.prefilter;
+        let sums = view.sums;
+        // The features the clusters and the fit read: the albedo's noise averaged out across
+        // neighbours.
         let filtered;
-        // The albedo the clusters and the fit read: its noise averaged out across neighbours.
-        let sums = if radius > 0 && self.features.is_some() && view.sums.keeps_features() {
-            filtered = prefilter_albedo(grid, view.sums, radius, kappa);
+        let cell_features = if radius > 0 && self.features.is_some() {
+            filtered = prefilter_albedo(grid, sums, radius, kappa);
             &filtered
         } else {
-            view.sums
+            &sums.features
         };
         let features = self.features;
         let grown: Option<Initial>;
@@ -159,7 +162,7 @@ impl PolynomialFilter {
                     z if z > 0.0 => z,
                     _ => FEATURE_NOISE_Z,
                 };
-                by_noise = grow_by_noise(grid, sums, z, features);
+                by_noise = grow_by_noise_with(grid, sums, cell_features, z, features);
                 (
                     by_noise.clusters.iter().map(Vec::as_slice).collect(),
                     &by_noise.of_cell,
@@ -199,7 +202,7 @@ impl PolynomialFilter {
             .map(|c| {
                 let cells: Vec<FitCell> = c
                     .iter()
-                    .map(|&i| fit_cell(grid, sums, i as usize, self.weights))
+                    .map(|&i| fit_cell(grid, sums, cell_features, i as usize, self.weights))
                     .collect();
                 let fit = Fit::new(&cells, n, &settings);
                 let noise = pooled_noise(sums, c);
@@ -238,6 +241,7 @@ impl PolynomialFilter {
                 let (fits, noise, stats) = (&fits, &noise, stats);
                 (0..w).map(move |px| {
                     let model = Model {
+                        features: cell_features,
                         grid,
                         sums,
                         of_cell,
@@ -256,7 +260,13 @@ impl PolynomialFilter {
 }
 
 /// The fit's view of cell `i`, weighted by `weights`.
-fn fit_cell(grid: &CellGrid, sums: &CellSums, i: usize, weights: CellWeights) -> FitCell {
+fn fit_cell(
+    grid: &CellGrid,
+    sums: &CellSums,
+    features: &[Features],
+    i: usize,
+    weights: CellWeights,
+) -> FitCell {
     let (lo, hi) = grid.bounds(i);
     let n = sums.count[i];
     let dims = sums.dims();
@@ -266,7 +276,7 @@ fn fit_cell(grid: &CellGrid, sums: &CellSums, i: usize, weights: CellWeights) ->
         m1: [0.5; MAX_DIMS],
         m2: [1.0 / 3.0; MAX_DIMS],
         mean: [0.0; 3],
-        features: sums.mean_features(i).unwrap_or_default(),
+        features: sums.mean_features_of(features, i).unwrap_or_default(),
         weight: match weights {
             CellWeights::Count => f64::from(n),
             CellWeights::Uniform => f64::from(u8::from(n > 0)),
@@ -346,6 +356,8 @@ fn refit(
 
 /// The fitted clusters over the grid: what a pixel is integrated from.
 struct Model<'a> {
+    /// The cells' feature sums the fit read (prefiltered or the cells' own).
+    features: &'a [Features],
     grid: &'a CellGrid,
     sums: &'a CellSums,
     of_cell: &'a [u32],
@@ -395,7 +407,7 @@ impl Model<'_> {
                     if volume <= 0.0 {
                         continue;
                     }
-                    let features = self.sums.mean_features(i);
+                    let features = self.sums.mean_features_of(self.features, i);
                     let mut v = fit.mean_over(&lo, &hi, features.as_ref());
                     let count = self.sums.count[i];
                     if self.significance > 0.0 && count > 0 {
