@@ -491,12 +491,10 @@ mod tests {
 
     #[test]
     fn random_boxes_make_a_valid_tree() {
-        let mut state = 12345u64;
+        let mut k = 0u64;
         let mut f = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 40) as f32 / (1u64 << 24) as f32
+            k += 1;
+            (acr_plugins::rng::mix64(k) >> 40) as f32 / (1u64 << 24) as f32
         };
         for n in [1, 2, 3, 4, 5, 9, 17, 100, 5000] {
             let boxes: Vec<Aabb> = (0..n)

@@ -13,12 +13,11 @@ fn slow_scene(dir: &TempDir) -> PathBuf {
     dir.write("slow.pbrt", &text)
 }
 
-#[test]
-fn an_unknown_output_format_fails_before_rendering() {
-    let dir = TempDir::new("jpg");
-    let scene = slow_scene(&dir);
-    let out = dir.join("out.jpg");
-    let o = output_within(
+/// Renders the slow scene to `out` (in `dir`), which must fail within 20 s, before rendering;
+/// gives what it printed.
+fn render_slow_scene_to(dir: &TempDir, out: &Path) -> Output {
+    let scene = slow_scene(dir);
+    output_within(
         acr_command([
             "render".as_ref(),
             scene.as_os_str(),
@@ -28,7 +27,14 @@ fn an_unknown_output_format_fails_before_rendering() {
             "256".as_ref(),
         ]),
         Duration::from_secs(20),
-    );
+    )
+}
+
+#[test]
+fn an_unknown_output_format_fails_before_rendering() {
+    let dir = TempDir::new("jpg");
+    let out = dir.join("out.jpg");
+    let o = render_slow_scene_to(&dir, &out);
     assert_clean_failure(&o, "-o out.jpg");
     let err = stderr(&o);
     assert!(err.contains("jpg"), "the message names the format: {err}");
@@ -38,19 +44,8 @@ fn an_unknown_output_format_fails_before_rendering() {
 #[test]
 fn a_missing_output_folder_fails_cleanly_before_rendering() {
     let dir = TempDir::new("nofolder");
-    let scene = slow_scene(&dir);
     let out = dir.join("missing/deeper/out.png");
-    let o = output_within(
-        acr_command([
-            "render".as_ref(),
-            scene.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-            "--spp".as_ref(),
-            "256".as_ref(),
-        ]),
-        Duration::from_secs(20),
-    );
+    let o = render_slow_scene_to(&dir, &out);
     assert_clean_failure(&o, "-o missing/deeper/out.png");
     let err = stderr(&o);
     assert!(
