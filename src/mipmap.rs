@@ -147,12 +147,12 @@ impl<T: TexValue> MipMap<T> {
         }
     }
 
-    /// The number of levels.
     /// The finest level's width and height (the image's, raised to powers of two).
     pub fn size(&self) -> (usize, usize) {
         (self.levels[0].width(), self.levels[0].height())
     }
 
+    /// The number of levels.
     pub fn levels(&self) -> usize {
         self.levels.len()
     }

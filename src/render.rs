@@ -140,9 +140,10 @@ pub fn relative_error(stats: &[acr_plugins::PixelStats]) -> f64 {
             if s.count < 2 {
                 return 1.0;
             }
-            let mean = f64::from(crate::spectrum_luminance(s.mean())).max(0.0);
-            let var = f64::from(crate::spectrum_luminance(s.variance_of_mean())).max(0.0);
-            var.sqrt() / (mean + 0.01)
+            acr_plugins::film::relative_error_of(
+                f64::from(crate::spectrum_luminance(s.mean())),
+                f64::from(crate::spectrum_luminance(s.variance_of_mean())),
+            )
         })
         .sum();
     sum / stats.len() as f64

@@ -174,6 +174,13 @@ impl FilmSettings {
     }
 }
 
+/// The relative error `--noise-threshold` measures for a pixel or a cell: the standard error of
+/// its mean luminance over (that mean + 0.01), Cycles' and LuxCore's kind of measure; the 0.01
+/// keeps black pixels from dominating.
+pub fn relative_error_of(mean: f64, variance_of_mean: f64) -> f64 {
+    variance_of_mean.max(0.0).sqrt() / (mean.max(0.0) + 0.01)
+}
+
 /// The samples drawn for one pixel (those whose raster position lies in it), unfiltered:
 /// their count, mean and sum of squared deviations (Welford's running form, stable in f32).
 /// Single precision halves the film's per-pixel statistics (28 bytes a pixel, not 56: 28 MB

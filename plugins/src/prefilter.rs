@@ -6,6 +6,7 @@
 //! a noisy albedo loses its noise, and a precise one (its samples agree) is left alone.
 
 use crate::cluster::{CellGrid, CellSums};
+use crate::color::{luminance, Spectrum};
 use crate::first_hit::{Features, DEPTH, FEATURES, NORMAL};
 use rayon::prelude::*;
 
@@ -22,10 +23,10 @@ const SHADING_SCALE: f64 = 0.5;
 
 /// A cell's shading: its mean luminance over its mean albedo's (albedo floored at 0.01).
 fn shading(sums: &CellSums, i: usize, albedo: &[f64]) -> f64 {
-    let n = f64::from(sums.count[i].max(1));
-    let l = sums.rgb[i].map(|v| f64::from(v) / n);
-    let luminance = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-    luminance(l).max(1e-6) / luminance([albedo[0], albedo[1], albedo[2]]).max(0.01)
+    let n = sums.count[i].max(1) as f32;
+    let l = Spectrum::from_array(sums.rgb[i]) / n;
+    let a = Spectrum::new(albedo[0] as f32, albedo[1] as f32, albedo[2] as f32);
+    f64::from(luminance(l)).max(1e-6) / f64::from(luminance(a)).max(0.01)
 }
 
 /// The variance of cell `i`'s mean albedo, averaged over the channels: 0 (nothing known, so
@@ -62,10 +63,10 @@ fn log_similarity(fi: &[f64; FEATURES], fj: &[f64; FEATURES], v: f64, kappa: f64
     -dd * dd - dn / (NORMAL_SCALE * NORMAL_SCALE) + albedo
 }
 
-/// The feature sums of `sums` with each cell's albedo sum replaced by its count times the weighted mean albedo of
-/// the cells within `radius` image cells (the same time and lens bins), weighted by count,
-/// depth and normal agreement and NL-means on the albedo itself: a neighbour whose mean albedo
-/// differs by d (squared, over the channels) from the cell's weighs
+/// The feature sums of `sums` with each cell's albedo sum replaced by its count times the
+/// weighted mean albedo of the cells within `radius` image cells (the same time and lens bins),
+/// weighted by count, depth, normal and shading agreement and NL-means on the albedo itself: a
+/// neighbour whose mean albedo differs by d (squared, over the channels) from the cell's weighs
 /// exp(-max(0, d - v) / (kappa^2 v)), v the two cells' albedo variances of the mean summed.
 /// Sums without features or radiance, or a radius of 0, are returned unchanged.
 pub fn prefilter_albedo(

@@ -44,6 +44,9 @@ impl Item {
     fn hi(&self) -> Vec3A {
         Vec3A::from_array(self.hi)
     }
+    fn aabb(&self) -> Aabb {
+        Aabb::new(self.lo(), self.hi())
+    }
     /// Twice the centroid: the SAH only compares centroids, so the halving is skipped.
     fn centroid2(&self) -> Vec3A {
         self.lo() + self.hi()
@@ -173,11 +176,8 @@ fn set_of(items: &[Item], start: usize, end: usize) -> Set {
     let mut bounds = Aabb::empty();
     let mut centroids = Aabb::empty();
     for it in &items[start..end] {
-        bounds.min = bounds.min.min(it.lo());
-        bounds.max = bounds.max.max(it.hi());
-        let c = it.centroid2();
-        centroids.min = centroids.min.min(c);
-        centroids.max = centroids.max.max(c);
+        bounds = bounds.union(&it.aabb());
+        centroids.extend(it.centroid2());
     }
     Set {
         start,
@@ -288,8 +288,7 @@ impl Builder<'_> {
         let mut bins = [(Aabb::empty(), 0u32); BINS];
         for it in &self.items[set.start..set.end] {
             let bin = &mut bins[bin_of(it)];
-            bin.0.min = bin.0.min.min(it.lo());
-            bin.0.max = bin.0.max.max(it.hi());
+            bin.0 = bin.0.union(&it.aabb());
             bin.1 += 1;
         }
         // Cost of each plane (after bin k): area times count on both sides.
@@ -322,12 +321,10 @@ impl Builder<'_> {
         while i < j {
             let c = items[i].centroid2();
             if bin_of(&items[i]) <= plane {
-                lc.min = lc.min.min(c);
-                lc.max = lc.max.max(c);
+                lc.extend(c);
                 i += 1;
             } else {
-                rc.min = rc.min.min(c);
-                rc.max = rc.max.max(c);
+                rc.extend(c);
                 j -= 1;
                 items.swap(i, j);
             }
@@ -358,15 +355,13 @@ impl Builder<'_> {
         let mut right_area = [0.0f32; SMALL];
         let mut acc = Aabb::empty();
         for k in (1..n).rev() {
-            acc.min = acc.min.min(items[k].lo());
-            acc.max = acc.max.max(items[k].hi());
+            acc = acc.union(&items[k].aabb());
             right_area[k] = half_area(&acc);
         }
         let mut acc = Aabb::empty();
         let mut best = (f32::INFINITY, n / 2);
         for k in 1..n {
-            acc.min = acc.min.min(items[k - 1].lo());
-            acc.max = acc.max.max(items[k - 1].hi());
+            acc = acc.union(&items[k - 1].aabb());
             let cost = half_area(&acc) * k as f32 + right_area[k] * (n - k) as f32;
             if cost < best.0 {
                 best = (cost, k);
@@ -403,7 +398,7 @@ fn half_area(b: &Aabb) -> f32 {
 
 /// A node whose quantization grid spans `bounds`: per axis, the power of two such that 255
 /// steps cover the box (obvhs's convention), children empty.
-pub fn quantized_node(bounds: &Aabb) -> CwBvhNode {
+fn quantized_node(bounds: &Aabb) -> CwBvhNode {
     let e = ((bounds.max - bounds.min).max(Vec3A::splat(1e-20)) / 255.0)
         .to_array()
         .map(|x| x.log2().ceil().exp2());
@@ -416,7 +411,7 @@ pub fn quantized_node(bounds: &Aabb) -> CwBvhNode {
 
 /// Writes `child`'s box, rounded outwards onto the grid of `node` (which spans `bounds`), into
 /// `slot`.
-pub fn set_child_bounds(node: &mut CwBvhNode, bounds: &Aabb, slot: usize, child: &Aabb) {
+fn set_child_bounds(node: &mut CwBvhNode, bounds: &Aabb, slot: usize, child: &Aabb) {
     let step = node.e.map(|b| f32::from_bits((b as u32) << 23));
     let q = |v: Vec3A, round: fn(f32) -> f32| {
         let a = v - bounds.min;
@@ -438,7 +433,7 @@ pub fn set_child_bounds(node: &mut CwBvhNode, bounds: &Aabb, slot: usize, child:
 /// The child (an index into `centres`, at most eight) in each of a node's eight slots: obvhs's
 /// greedy assignment, a child to the slot whose octant direction points least towards it, so
 /// that a ray's octant visits the nearer children first.
-pub fn direction_slots(centres: &[Vec3A], centre: Vec3A) -> [Option<usize>; 8] {
+fn direction_slots(centres: &[Vec3A], centre: Vec3A) -> [Option<usize>; 8] {
     // cost[8k + s]: child k in slot s; taken rows and columns become infinite.
     let mut cost = [f32::INFINITY; 64];
     for (k, c) in centres.iter().enumerate().take(8) {

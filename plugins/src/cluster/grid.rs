@@ -508,9 +508,7 @@ impl CellSums {
 
     /// The mean first-hit features of cell `i`; None without samples or without features.
     pub fn mean_features(&self, i: usize) -> Option<[f64; crate::first_hit::FEATURES]> {
-        let n = *self.count.get(i)?;
-        let f = self.features.get(i)?;
-        (n > 0).then(|| f.map(|v| f64::from(v) / f64::from(n)))
+        self.mean_features_of(&self.features, i)
     }
 
     /// Whether the sums hold radiance and positions, not only luminance.
@@ -661,7 +659,7 @@ impl CellSums {
             + self.offset.capacity() * 4
             + self.offset_sq.capacity() * 4
             + self.features.capacity() * std::mem::size_of::<Features>()
-            + self.albedo_sq.capacity() * 12
+            + self.albedo_sq.capacity() * std::mem::size_of::<[f32; 3]>()
     }
 
     /// Active dims (offsets per cell).

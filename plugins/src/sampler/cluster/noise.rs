@@ -3,6 +3,7 @@
 //! when `settle` is on.
 
 use super::{ClusterSampler, Phase, SobolSampler, SALT};
+use crate::film::relative_error_of;
 
 impl ClusterSampler {
     /// Stops where the error is below `threshold` (with `settle`), once the cells hold
@@ -34,8 +35,8 @@ impl ClusterSampler {
             if n < least.max(2) {
                 return f64::INFINITY;
             }
-            let mean = self.sums.mean(c).unwrap_or(0.0).max(0.0);
-            total += (self.sums.variance(c) / f64::from(n)).sqrt() / (mean + 0.01);
+            let mean = self.sums.mean(c).unwrap_or(0.0);
+            total += relative_error_of(mean, self.sums.variance(c) / f64::from(n));
         }
         total / cells.len().max(1) as f64
     }
