@@ -311,7 +311,7 @@ pub fn render_with(
     let space = rendering_space(scene);
     let mut counts = RenderCounts::default();
     if sampler.streams() == 2 {
-        film.split_streams();
+        film.split_streams(sampler.stream_weight());
     }
     if let Some(p) = progress {
         p.set_length(space.pixels() * u64::from(sampler.spp()));

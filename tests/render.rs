@@ -617,9 +617,12 @@ fn the_cluster_sampler_sums_radiance_in_its_cells_only_for_a_filter_that_reads_t
     let mut warnings = Vec::new();
     let scene = Scene::build(&desc, &mut warnings).unwrap();
     for (filter, reads) in [("gaussian", false), ("box", false), ("polynomial", true)] {
+        // The sampler as published keeps one set of cells; an unbiased pair's halves hold the
+        // other colour's first stage only, and the film collects the cells instead.
         let overrides = Overrides {
             sampler: Some("cluster".into()),
             filter: Some(filter.into()),
+            settings: vec![acr_plugins::Setting::parse("sampler.unbiased=false").unwrap()],
             ..Default::default()
         };
         let mut plugins =

@@ -254,6 +254,8 @@ pub struct Film {
     /// The two streams' films, when the samples come in two ([`Film::split_streams`]): the
     /// splats and cells go there, and this film keeps the pixel statistics of both.
     halves: Option<Box<[Film; 2]>>,
+    /// The first stream's weight in the image, when split (the second's is 1 minus it).
+    first_weight: f64,
 }
 
 /// Film columns a [`Prepared`] sample can reach: enough for filters of radius up to 3.5
@@ -422,14 +424,16 @@ impl Film {
             cells: None,
             located: Vec::new(),
             halves: None,
+            first_weight: 0.5,
         }
     }
 
     /// Keeps the two sample streams of a paired sampler apart (a sample's stream is its
-    /// index's parity): each gets a film of its own, and the image is their mean, so that
-    /// neither stream's share of a pixel depends on the other's values. Called before any
-    /// sample is added.
-    pub fn split_streams(&mut self) {
+    /// index's parity): each gets a film of its own, and the image is their blend with the
+    /// fixed weights `first_weight` and 1 minus it, so that neither stream's share of a pixel
+    /// depends on the values. Called before any sample is added.
+    pub fn split_streams(&mut self, first_weight: f64) {
+        self.first_weight = first_weight.clamp(0.0, 1.0);
         if self.halves.is_some() {
             return;
         }
@@ -445,15 +449,25 @@ impl Film {
         self.halves.as_deref()
     }
 
-    /// The image `image` makes of this film, or when it is split, the mean of the images it
-    /// makes of each stream's film (`image` gets the stream's number).
+    /// The image `image` makes of this film, or when it is split, the blend of the images it
+    /// makes of each stream's film (`image` gets the stream's number) with the weights of
+    /// [`Film::split_streams`]. A pixel one stream left without a sample (a time limit that
+    /// stopped it, dropped samples) takes the other's alone.
     pub fn per_stream(&self, image: impl Fn(&Film, usize) -> Vec<Spectrum>) -> Vec<Spectrum> {
         match self.halves() {
-            Some([a, b]) => image(a, 0)
-                .into_iter()
-                .zip(image(b, 1))
-                .map(|(x, y)| (x + y) * 0.5)
-                .collect(),
+            Some([a, b]) => {
+                let w = self.first_weight as f32;
+                image(a, 0)
+                    .into_iter()
+                    .zip(image(b, 1))
+                    .zip(a.stats.iter().zip(&b.stats))
+                    .map(|((x, y), (sa, sb))| match (sa.count, sb.count) {
+                        (0, n) if n > 0 => y,
+                        (n, 0) if n > 0 => x,
+                        _ => x * w + y * (1.0 - w),
+                    })
+                    .collect()
+            }
             None => image(self, 0),
         }
     }
@@ -668,8 +682,8 @@ impl Film {
     /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
     /// `scale` is applied on output, not here).
     pub fn pixels(&self) -> Vec<Spectrum> {
-        if let Some(h) = &self.halves {
-            return h[0].mean_with(&h[1]);
+        if self.halves.is_some() {
+            return self.per_stream(|f, _| f.pixels());
         }
         self.sums
             .iter()
@@ -686,22 +700,6 @@ impl Film {
                 } else {
                     Spectrum::ZERO
                 }
-            })
-            .collect()
-    }
-}
-
-impl Film {
-    /// The mean of this film's image and `other`'s (of the same size), pixel by pixel; a pixel
-    /// that one of them has no weight at takes the other's value.
-    fn mean_with(&self, other: &Film) -> Vec<Spectrum> {
-        let (a, b) = (self.pixels(), other.pixels());
-        let weighed = |f: &Film, i: usize| f.sums[i][3] != 0.0;
-        (0..a.len())
-            .map(|i| match (weighed(self, i), weighed(other, i)) {
-                (true, false) => a[i],
-                (false, true) => b[i],
-                _ => (a[i] + b[i]) * 0.5,
             })
             .collect()
     }

@@ -149,7 +149,7 @@ fn a_split_film_is_the_mean_of_its_streams() {
         FilmSettings::with_resolution(2, 1),
         &BoxFilter::new(0.5, 0.5),
     );
-    film.split_streams();
+    film.split_streams(0.5);
     // Pixel 0: stream 0 has three samples of 1, stream 1 one of 5: the mean of the stream
     // means is 3, where the mean of the samples would be 2. Pixel 1: stream 1 only.
     let s0 = [(Vec2::new(0.2, 0.5), Vec3::splat(1.0)); 3];

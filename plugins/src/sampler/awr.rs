@@ -204,6 +204,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
             pixel_rounds::ROUND_PARAMS[0],
             pixel_rounds::ROUND_PARAMS[1],
             pixel_rounds::ROUND_PARAMS[2],
+            pixel_rounds::ROUND_PARAMS[3],
             ParamSpec::new(
                 "threshold",
                 ParamType::Float,
@@ -211,6 +212,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "soft threshold of the detail coefficients, in noise standard deviations",
             ),
             super::paired::STREAMS,
+            super::paired::PILOT,
         ],
     },
     build: build_streams,

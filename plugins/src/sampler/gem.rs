@@ -183,6 +183,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
             pixel_rounds::ROUND_PARAMS[0],
             pixel_rounds::ROUND_PARAMS[1],
             pixel_rounds::ROUND_PARAMS[2],
+            pixel_rounds::ROUND_PARAMS[3],
             ParamSpec::new(
                 "scales",
                 ParamType::Integer,
@@ -202,6 +203,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "a coarser scale is kept while its squared change <= gamma x the variances",
             ),
             super::paired::STREAMS,
+            super::paired::PILOT,
         ],
     },
     build: build_streams,

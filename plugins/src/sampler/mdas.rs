@@ -615,6 +615,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "pixels one unit of time or lens counts as when choosing the longest axis",
             ),
             super::paired::STREAMS,
+            super::paired::PILOT,
         ],
     },
     build: build_streams,

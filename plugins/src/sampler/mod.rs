@@ -72,6 +72,12 @@ pub trait Sampler: Send {
         1
     }
 
+    /// With two streams, the first stream's fixed weight in the image (the second's is 1
+    /// minus it): a half for two equal streams, the pilot's share of the budget for a pilot.
+    fn stream_weight(&self) -> f64 {
+        0.5
+    }
+
     /// Asks the sampler to stop early (a time limit): it ends its current pass, so that every
     /// pixel has as many samples as the others (at least one pass), then gives no more.
     fn halt(&mut self);

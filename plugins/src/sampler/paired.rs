@@ -1,21 +1,23 @@
-//! Two streams of an adaptive sampler, each deciding where the *other* stream's samples go
+//! Two streams of an adaptive sampler whose decisions never read the values they decide
 //! (issue 26, item 3). An adaptive sampler that decides a pixel's count from the samples that
 //! then estimate it biases the image: where the rare outcome is the bright one, a pixel whose
-//! first samples agree looks settled and keeps its dark estimate. Here two instances of the
-//! sampler, each with half the budget, learn only from each other's values; a point's stream is
-//! its sample index's parity, the film keeps the streams apart ([`Film::split_streams`]) and
-//! the image is the mean of the two streams' images, with equal weights (weights from the
-//! counts would bring the dependence back). A stream's first adaptive round is decided from
-//! the other's first stage alone; after that, a stream's values still reach its own later
-//! rounds through where the other stream's points went (measured in the README: on the
-//! cluster sampler that path shifts the mean about as much as the one it replaces, the other
-//! way, so one stream stays the default).
+//! first samples agree looks settled and keeps its dark estimate. A point's stream is its
+//! sample index's parity and the film keeps the streams apart ([`Film::split_streams`]); the
+//! image is a blend of the two streams' images with fixed weights (weights from the counts
+//! would bring the dependence back). Two layouts:
+//! - `pilot` (a share a of the budget): a value-blind pilot stream, every pixel the same count,
+//!   traced first; the adaptive stream decides from the pilot's values alone (its own are
+//!   never read) and gives every pixel at least one sample; the image is a * pilot + (1 - a) *
+//!   adaptive. No path leads from a value to its own pixel's weight: unbiased.
+//! - `streams 2`: two half-budget instances, each learning only from the other's values, the
+//!   image their mean. After the first adaptive round a stream's values still reach its own
+//!   later rounds through where the other stream's points went (measured in the README).
 
 use super::{pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, SamplerSetup};
 use crate::cluster::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
-use crate::registry::{int_in, Choice, ParamSpec};
+use crate::registry::{float_in, int_in, Choice, ParamSpec};
 use crate::space::SamplePoint;
 use acr_parser::{Param, ParamType, Result, Values};
 use std::collections::VecDeque;
@@ -30,20 +32,43 @@ pub(crate) const STREAMS: ParamSpec = ParamSpec::new(
      sign and the MSE grows; see the README)",
 );
 
+/// The `pilot` parameter every adaptive sampler declares.
+pub(crate) const PILOT: ParamSpec = ParamSpec::new(
+    "pilot",
+    ParamType::Float,
+    "0",
+    "share of the budget traced first as a value-blind pilot stream that alone decides where \
+     the rest goes; the image blends the two with fixed weights, so the mean is unbiased \
+     (0: off, decisions read every value, as the method was published)",
+);
+
 /// Per-pixel count parameters that each stream takes half of.
 const HALVED: [(&str, i32); 2] = [("initspp", 1), ("minspp", 0)];
 
-/// Builds the sampler of `build` as two streams when its `streams` parameter is 2 and the
-/// budget has at least two samples per pixel; else as one (the default).
+/// Builds the sampler of `build` as a pilot and an adaptive stream when its `pilot` share is
+/// above 0, as two streams when its `streams` parameter is 2, and as one otherwise (the
+/// default); a budget under two samples per pixel is always one stream.
 pub(crate) fn wrap(
     c: &Choice,
     setup: &SamplerSetup,
     build: SamplerBuild,
 ) -> Result<Box<dyn Sampler>> {
     let streams = int_in(&c.params, "streams", 1, 1..=2)?;
+    let pilot = float_in(&c.params, "pilot", 0.0, 0.0..=0.9)?;
     let spp = pixel_samples(&c.params, setup)?;
-    if streams == 1 || spp < 2 {
+    if pilot > 0.0 && streams == 2 {
+        let p = c.params.get("pilot").or_else(|| c.params.get("streams"));
+        let message = "a sampler takes a pilot stream or two streams, not both";
+        return Err(match p {
+            Some(p) => acr_parser::Error::at(&p.loc, message),
+            None => acr_parser::Error::file("sampler", message),
+        });
+    }
+    if spp < 2 || (streams == 1 && pilot == 0.0) {
         return build(c, setup);
+    }
+    if pilot > 0.0 {
+        return with_pilot(c, setup, build, pilot, spp);
     }
     let shares = [spp.div_ceil(2), spp / 2];
     let mut built = Vec::with_capacity(2);
@@ -64,25 +89,81 @@ pub(crate) fn wrap(
                 }
             }
         }
-        let stream = IndexStream {
-            count: 2,
-            which: s as u32,
-        };
-        let setup = SamplerSetup {
-            spp: Some(share),
-            // Independent points: a stream's values must say nothing of where the other's
-            // points lie (one scrambled sequence shared would pair them by strata).
-            seed: stream.seed(setup.seed),
-            stream,
-            // The film collects each stream's cells: the sampler's hold both streams' values.
-            reconstruction_reads_cells: false,
-            ..*setup
-        };
-        built.push(build(&choice, &setup)?);
+        built.push(build(&choice, &stream_setup(setup, s as u32, share))?);
     }
     let second = built.pop().expect("two");
     let first = built.pop().expect("two");
     Ok(Box::new(Paired::new([first, second], spp)))
+}
+
+/// The setup of stream `which` of two, `spp` samples per pixel: its own seed (independent
+/// points: a stream's values must say nothing of where the other's points lie, as one
+/// scrambled sequence shared would pair them by strata) and its own sample indices.
+fn stream_setup(setup: &SamplerSetup, which: u32, spp: u32) -> SamplerSetup {
+    let stream = IndexStream { count: 2, which };
+    SamplerSetup {
+        spp: Some(spp),
+        seed: stream.seed(setup.seed),
+        stream,
+        // The film collects each stream's cells: the sampler's hold the other stream's values.
+        reconstruction_reads_cells: false,
+        ..*setup
+    }
+}
+
+/// `c` with the integer parameter `name` set to `v` (a later parameter overrides).
+fn with_int(c: &Choice, name: &str, v: u32) -> Choice {
+    let mut choice = c.clone();
+    // Where the value came from, for an error that names it: the parameter, the directive,
+    // or else the pilot's own setting.
+    let loc = c
+        .params
+        .get(name)
+        .map(|p| p.loc.clone())
+        .or_else(|| c.loc.clone())
+        .unwrap_or_else(|| acr_parser::Loc::new(&acr_parser::SourceFile::new("sampler", ""), 0));
+    choice.params.push(Param::new(
+        ParamType::Integer,
+        name,
+        Values::Ints(vec![v as i32]),
+        loc,
+    ));
+    choice
+}
+
+/// A pilot stream of `pilot` of the budget (at least one sample per pixel, at most all but
+/// one), every pixel alike, and the adaptive stream placed from the pilot's values alone.
+fn with_pilot(
+    c: &Choice,
+    setup: &SamplerSetup,
+    build: SamplerBuild,
+    pilot: f64,
+    spp: u32,
+) -> Result<Box<dyn Sampler>> {
+    let first = ((f64::from(spp) * pilot).round() as u32).clamp(1, spp - 1);
+    // The pilot is the first stage's whole budget: it never adapts.
+    let mut pilot_choice = with_int(c, "initspp", first);
+    // The adaptive stream's own first stage is one sample per pixel: every pixel needs one for
+    // its fixed-weight mean, and the pilot already did what a first stage is for. A minimum
+    // count the user asked for is met by both streams together.
+    let rest = spp - first;
+    let mut adaptive_choice = with_int(c, "initspp", 1);
+    if let Some(Values::Ints(v)) = c.params.get("minspp").map(|p| &p.values) {
+        // Out-of-range values are left for the sampler to report.
+        if let [v] = v[..] {
+            if (0..=spp as i32).contains(&v) {
+                let least = v as u32;
+                pilot_choice = with_int(&pilot_choice, "minspp", least.min(first));
+                let left = least.saturating_sub(first);
+                adaptive_choice = with_int(&adaptive_choice, "minspp", left);
+            }
+        }
+    }
+    let pilot_stream = build(&pilot_choice, &stream_setup(setup, 0, first))?;
+    let adaptive = build(&adaptive_choice, &stream_setup(setup, 1, rest))?;
+    let mut paired = Paired::new([pilot_stream, adaptive], spp);
+    paired.pilot = Some(f64::from(first) / f64::from(spp));
+    Ok(Box::new(paired))
 }
 
 /// Two streams of one adaptive sampler, each fed the other's values.
@@ -95,6 +176,9 @@ pub(crate) struct Paired {
     turn: usize,
     /// Streams whose budget is spent.
     done: [bool; 2],
+    /// With a pilot (stream 0), its share of the budget: its weight in the image. The pilot is
+    /// traced first, and only the adaptive stream learns.
+    pilot: Option<f64>,
 }
 
 impl Paired {
@@ -106,6 +190,7 @@ impl Paired {
             given: VecDeque::new(),
             turn: 0,
             done: [false; 2],
+            pilot: None,
         }
     }
 }
@@ -121,7 +206,11 @@ impl Sampler for Paired {
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
         out.clear();
-        // Batches alternate between the streams while both have some.
+        // A pilot goes first, whole: the adaptive stream decides from all of it.
+        if self.pilot.is_some() && !self.done[0] {
+            self.turn = 0;
+        }
+        // Otherwise batches alternate between the streams while both have some.
         for _ in 0..2 {
             let s = self.turn;
             self.turn = 1 - s;
@@ -141,7 +230,11 @@ impl Sampler for Paired {
         let Some(s) = self.given.pop_front() else {
             return;
         };
-        self.streams[1 - s].observe_other(batch, radiance);
+        // The pilot learns the adaptive stream's values only to make that stream's image
+        // (mdas, gem, awr); its own points never depend on them.
+        if self.pilot.is_none() || s == 0 || self.streams[0].reconstructs() {
+            self.streams[1 - s].observe_other(batch, radiance);
+        }
         self.streams[s].retire(batch);
     }
 
@@ -162,8 +255,13 @@ impl Sampler for Paired {
         2
     }
 
+    fn stream_weight(&self) -> f64 {
+        self.pilot.unwrap_or(0.5)
+    }
+
     fn partition(&self) -> Option<&Partition> {
-        self.streams[0].partition()
+        // With a pilot, the clusters are the adaptive stream's.
+        self.streams[usize::from(self.pilot.is_some())].partition()
     }
 
     fn cells(&self) -> Option<CellView<'_>> {

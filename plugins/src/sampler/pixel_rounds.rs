@@ -103,6 +103,9 @@ pub(crate) struct PixelRounds<M> {
     given: Vec<u32>,
     rounds: u64,
     halted: bool,
+    /// Each pixel's count decided from the other colour of a checkerboard, from the first
+    /// round alone (`unbiased`).
+    unbiased: bool,
 }
 
 impl<M: PixelMethod> PixelRounds<M> {
@@ -136,7 +139,75 @@ impl<M: PixelMethod> PixelRounds<M> {
             given: vec![0; pixels],
             rounds: 1,
             halted: false,
+            unbiased: false,
         }
+    }
+
+    /// The same sampler deciding without selection bias (`unbiased`): the whole adaptive
+    /// budget in one round after the first, each pixel's share from the other colour's
+    /// first-round samples alone.
+    pub(crate) fn unbiased(mut self, on: bool) -> Self {
+        self.unbiased = on && self.space.pixels() > 1;
+        if self.unbiased {
+            self.round_size = self.unplanned;
+        }
+        self
+    }
+
+    /// Each pixel's error as the method estimates it from moments in which every pixel of
+    /// its colour (parity of column + row) holds its four neighbours' pooled samples instead
+    /// of its own: so a pixel's error reads only the other colour's samples.
+    fn crossed_error(&self) -> Vec<f64> {
+        let (w, h) = (self.space.width() as usize, self.space.height() as usize);
+        let mut error = vec![0.0; w * h];
+        for colour in 0..2 {
+            let mut m = self.moments.clone();
+            for y in 0..h {
+                for x in (0..w).filter(|x| (x + y) & 1 == colour) {
+                    let i = y * w + x;
+                    let (mut count, mut sum, mut sum_sq) = (0, [0.0; 3], 0.0);
+                    let near = [(x > 0, i.wrapping_sub(1)), (x + 1 < w, i + 1)];
+                    let rows = [(y > 0, i.wrapping_sub(w)), (y + 1 < h, i + w)];
+                    for (_, j) in near.into_iter().chain(rows).filter(|n| n.0) {
+                        count += self.moments.count[j];
+                        for c in 0..3 {
+                            sum[c] += self.moments.sum[j][c];
+                        }
+                        sum_sq += self.moments.sum_sq[j];
+                    }
+                    (m.count[i], m.sum[i], m.sum_sq[i]) = (count, sum, sum_sq);
+                }
+            }
+            let e = self.method.error(&self.space, &m);
+            for y in 0..h {
+                for x in (0..w).filter(|x| (x + y) & 1 == colour) {
+                    error[y * w + x] = e[y * w + x];
+                }
+            }
+        }
+        error
+    }
+
+    /// `n` samples over the pixels by `error`, each colour taking its share of pixels' worth
+    /// and allocating it among its own pixels (so that neither colour's total reads the
+    /// other's errors).
+    fn allocate_by_colour(&self, error: &[f64], n: u64) -> Vec<u32> {
+        let w = self.space.width() as usize;
+        let colour_of = |i: usize| (i % w + i / w) & 1;
+        let pixels = error.len() as u64;
+        let zeros = pixels.div_ceil(2);
+        let share = [n * zeros / pixels, n - n * zeros / pixels];
+        let mut plan = vec![0; error.len()];
+        for (colour, &n) in share.iter().enumerate() {
+            let own: Vec<usize> = (0..error.len())
+                .filter(|&i| colour_of(i) == colour)
+                .collect();
+            let weights: Vec<f64> = own.iter().map(|&i| error[i]).collect();
+            for (&i, k) in own.iter().zip(allocate(&weights, n)) {
+                plan[i] = k;
+            }
+        }
+        plan
     }
 
     /// The same sampler giving stream `stream`'s sample indices.
@@ -151,8 +222,13 @@ impl<M: PixelMethod> PixelRounds<M> {
             return false;
         }
         let n = self.round_size.min(self.unplanned);
-        let error = self.method.error(&self.space, &self.moments);
-        self.plan = allocate(&error, n);
+        self.plan = if self.unbiased {
+            let error = self.crossed_error();
+            self.allocate_by_colour(&error, n)
+        } else {
+            let error = self.method.error(&self.space, &self.moments);
+            allocate(&error, n)
+        };
         self.cursor = 0;
         self.unplanned -= n;
         self.rounds += 1;
@@ -168,7 +244,7 @@ impl<M: PixelMethod> PixelRounds<M> {
 }
 
 /// The parameters every image-space adaptive method declares first.
-pub(crate) const ROUND_PARAMS: [ParamSpec; 3] = [
+pub(crate) const ROUND_PARAMS: [ParamSpec; 4] = [
     super::PIXELSAMPLES_ON_AVERAGE,
     ParamSpec::new(
         "initspp",
@@ -181,6 +257,13 @@ pub(crate) const ROUND_PARAMS: [ParamSpec; 3] = [
         ParamType::Integer,
         "4",
         "adaptive rounds after it",
+    ),
+    ParamSpec::new(
+        "unbiased",
+        ParamType::Bool,
+        "false",
+        "decide each pixel's count from the other colour of a checkerboard, from the first \
+         round alone (one adaptive round), so that no pixel's count reads its own values",
     ),
 ];
 
@@ -200,9 +283,11 @@ pub(crate) fn build<M: PixelMethod + 'static>(
         1..=i64::from(spp),
     )?;
     let rounds = int_in(params, "rounds", 4, 1..=64)?;
+    let unbiased = params.bool_or("unbiased", false)?;
     Ok(Box::new(
         PixelRounds::new(method, setup.space, spp, init, rounds, setup.seed, salt)
-            .with_stream(setup.stream),
+            .with_stream(setup.stream)
+            .unbiased(unbiased),
     ))
 }
 

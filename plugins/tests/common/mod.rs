@@ -22,6 +22,17 @@ pub fn sampler_with(
     spp: u32,
     seed: u64,
 ) -> Box<dyn Sampler> {
+    try_sampler_with(choice, space, spp, seed).unwrap()
+}
+
+/// The sampler of `choice`, or the error its parameters give.
+#[allow(dead_code)]
+pub fn try_sampler_with(
+    choice: Choice,
+    space: RenderingSpace,
+    spp: u32,
+    seed: u64,
+) -> acr_parser::Result<Box<dyn Sampler>> {
     let name = choice.name.clone();
     let e = SAMPLERS
         .iter()
@@ -34,7 +45,7 @@ pub fn sampler_with(
         reconstruction_reads_cells: true,
         stream: Default::default(),
     };
-    (e.build)(&choice, &setup).unwrap()
+    (e.build)(&choice, &setup)
 }
 
 /// The image `f` makes over `space` from the samples of `s` on a field that gives each point
@@ -59,7 +70,7 @@ pub fn render_field(
     }
     // A paired sampler's two streams are kept apart, as the render loop does.
     if s.streams() == 2 {
-        film.split_streams();
+        film.split_streams(s.stream_weight());
     }
     let mut batch = Vec::new();
     while s.next_batch(&mut batch) {

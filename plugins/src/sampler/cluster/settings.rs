@@ -59,6 +59,11 @@ pub struct ClusterSettings {
     /// With `--noise-threshold`, a cluster whose own relative error is below the threshold
     /// leaves the queue (measured: more error per sample than letting the priority run).
     pub settle: bool,
+    /// The colour (parity of column + row, from the space's corner) of the pixels whose
+    /// adaptive samples it places, when it is one half of an unbiased pair (see
+    /// `crossed.rs`); a sample drawn at a pixel of the other colour goes to its partner
+    /// pixel in the same row (or column). `None`: every pixel.
+    pub colour: Option<u32>,
 }
 
 impl ClusterSettings {
@@ -94,6 +99,7 @@ impl ClusterSettings {
             stream: IndexStream::ALL,
             init_given: false,
             settle: false,
+            colour: None,
         }
     }
 
@@ -209,7 +215,16 @@ pub(in crate::sampler) const ENTRY: Entry<SamplerBuild> = Entry {
                  threshold gets no more samples (measured: more error per sample than leaving \
                  it to the priority; see the README)",
             ),
+            ParamSpec::new(
+                "unbiased",
+                ParamType::Bool,
+                "true (false with pilot or streams)",
+                "place each pixel's adaptive samples from other pixels' first-stage samples \
+                 only (a checkerboard of two halves), so that no pixel's count depends on its \
+                 own values and the image mean is unbiased",
+            ),
             crate::sampler::paired::STREAMS,
+            crate::sampler::paired::PILOT,
         ],
     },
     build: build_streams,
@@ -232,6 +247,24 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
     s.cell_size = float_in(p, "cellsize", s.cell_size, 0.125..=64.0)?;
     s.bins = int_in(p, "bins", s.bins as i32, 1..=16)?;
     let max = i64::from(spp);
+    // Unbiased unless it is one stream of a pilot or of two streams, which take the bias off
+    // (or not) their own way.
+    let whole = setup.stream == IndexStream::ALL;
+    let unbiased = p.bool_or("unbiased", whole)? && setup.space.pixels() > 1;
+    if unbiased && !whole {
+        let loc = p.get("unbiased").map(|x| x.loc.clone());
+        let message = "unbiased cannot be combined with a pilot or two streams";
+        return Err(match loc {
+            Some(l) => Error::at(&l, message),
+            None => Error::file("cluster sampler", message),
+        });
+    }
+    if unbiased {
+        // Decisions read the first stage alone: two samples per pixel at least, so that each
+        // cell has a variance (measured at 4 spp: MSE 0.70x and 0.76x that of one sample on
+        // motion-blur and depth-of-field).
+        s.init_spp = (spp / 4).max(2).min(spp);
+    }
     s.init_spp = int_in(p, "initspp", s.init_spp as i32, 1..=max)?;
     s.init_given = p.get("initspp").is_some();
     s.settle = p.bool_or("settle", s.settle)?;
@@ -274,6 +307,20 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
             Some(l) => Error::at(&l, message),
             None => Error::file("cluster sampler", message),
         });
+    }
+    if unbiased {
+        if !s.even_pixels {
+            let loc = p.get("evenpixels").map(|x| x.loc.clone());
+            let message = "unbiased needs evenpixels: a pixel's points must be its own sequence";
+            return Err(match loc {
+                Some(l) => Error::at(&l, message),
+                None => Error::file("cluster sampler", message),
+            });
+        }
+        // Neither half's cells are what the reconstruction reads: the film collects them.
+        s.keep_radiance = false;
+        let half = |colour| ClusterSampler::new(setup.space, s, setup.seed).for_colour(colour);
+        return Ok(Box::new(super::crossed::Crossed::new([half(0), half(1)])));
     }
     Ok(Box::new(ClusterSampler::new(setup.space, s, setup.seed)))
 }

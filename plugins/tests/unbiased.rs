@@ -1,0 +1,216 @@
+//! Adaptive sampling whose decisions never read the values they decide (issue 26, item 3):
+//! the cluster sampler's `unbiased` checkerboard, where a pixel's count comes from the other
+//! colour's first stage only, and every adaptive sampler's `pilot` stream, which alone decides
+//! where the adaptive stream's samples go.
+
+mod common;
+
+use acr_parser::{Loc, Param, ParamType, SourceFile, Values};
+use acr_plugins::film::{Film, FilmSettings};
+use acr_plugins::filters::BoxFilter;
+use acr_plugins::rng::mix64;
+use acr_plugins::sampler::drive;
+use acr_plugins::{Choice, Dims, RenderingSpace, SamplePoint};
+use glam::{Vec2, Vec3};
+use std::collections::{HashMap, HashSet};
+
+const ADAPTIVE: [&str; 4] = ["cluster", "mdas", "gem", "awr"];
+
+fn space() -> RenderingSpace {
+    RenderingSpace {
+        x0: 0,
+        x1: 24,
+        y0: 0,
+        y1: 17,
+        dims: Dims {
+            time: true,
+            lens: false,
+        },
+    }
+}
+
+/// A noisy step moving in time, with a bright outlier now and then; `extra` adds noise to
+/// the samples `changed` picks.
+fn field(q: &SamplePoint, extra: f32, changed: impl Fn(&SamplePoint) -> bool) -> [f32; 3] {
+    let h = mix64(u64::from(q.film[0].to_bits()) ^ mix64(u64::from(q.time.to_bits())));
+    let u = (h >> 40) as f32 / (1u64 << 24) as f32;
+    let base = if q.film[0] > 8.0 + 8.0 * q.time {
+        1.0
+    } else {
+        0.1
+    };
+    let firefly = if u > 0.97 { 20.0 } else { 0.0 };
+    let v = base + 0.2 * u + firefly;
+    let w = (h & 0xffff) as f32 / 65536.0;
+    [if changed(q) { v + extra * w } else { v }; 3]
+}
+
+/// The sampler `name` with the parameters `params` (name, value).
+fn sampler(name: &str, params: &[(&str, Values)], spp: u32) -> Box<dyn acr_plugins::Sampler> {
+    let mut c = Choice::new(None, name, None);
+    let file = SourceFile::new("test", "");
+    for (p, v) in params {
+        let ty = match v {
+            Values::Bools(_) => ParamType::Bool,
+            Values::Floats(_) => ParamType::Float,
+            _ => ParamType::Integer,
+        };
+        c.params
+            .push(Param::new(ty, *p, v.clone(), Loc::new(&file, 0)));
+    }
+    common::sampler_with(c, space(), spp, 7)
+}
+
+fn unbiased(spp: u32) -> Box<dyn acr_plugins::Sampler> {
+    sampler("cluster", &[("unbiased", Values::Bools(vec![true]))], spp)
+}
+
+fn colour(q: &SamplePoint) -> u32 {
+    (q.pixel[0] + q.pixel[1]) & 1
+}
+
+fn key(q: &SamplePoint) -> (u32, u32, u32, [u32; 2]) {
+    (
+        q.pixel[0],
+        q.pixel[1],
+        q.index,
+        [q.film[0].to_bits(), q.time.to_bits()],
+    )
+}
+
+/// Every point the sampler gives on the field, with `extra` noise where `changed`.
+fn points(
+    mut s: Box<dyn acr_plugins::Sampler>,
+    extra: f32,
+    changed: impl Fn(&SamplePoint) -> bool + Copy,
+) -> Vec<SamplePoint> {
+    drive(
+        s.as_mut(),
+        |b| b.iter().map(|q| field(q, extra, changed)).collect(),
+        None,
+    )
+}
+
+/// The points of `p` that `keep` picks, in a canonical order.
+fn sorted(
+    p: &[SamplePoint],
+    keep: impl Fn(&SamplePoint) -> bool,
+) -> Vec<(u32, u32, u32, [u32; 2])> {
+    let mut k: Vec<_> = p.iter().filter(|q| keep(q)).map(key).collect();
+    k.sort_unstable();
+    k
+}
+
+#[test]
+fn an_unbiased_pixels_points_do_not_depend_on_its_own_values() {
+    // The values of colour-0 pixels change: their points (how many, where) stay, since they
+    // are placed from colour-1 pixels' first stage; colour-1 pixels' points move.
+    let base = points(unbiased(8), 0.0, |_| false);
+    let changed = points(unbiased(8), 3.0, |q| colour(q) == 0);
+    // (`assert!` rather than `assert_eq!`: the point lists are long.)
+    assert!(
+        sorted(&base, |q| colour(q) == 0) == sorted(&changed, |q| colour(q) == 0),
+        "colour-0 pixels' points followed their own values"
+    );
+    assert!(
+        sorted(&base, |q| colour(q) == 1) != sorted(&changed, |q| colour(q) == 1),
+        "colour-1 pixels ignored colour-0 values"
+    );
+    // And the same the other way round.
+    let changed = points(unbiased(8), 3.0, |q| colour(q) == 1);
+    assert!(sorted(&base, |q| colour(q) == 1) == sorted(&changed, |q| colour(q) == 1));
+    // Later rounds do not learn either: values changed after the first stage move nothing.
+    let late = points(unbiased(8), 3.0, |q| q.index >= 2);
+    assert!(sorted(&base, |_| true) == sorted(&late, |_| true));
+}
+
+#[test]
+fn an_unbiased_cluster_sampler_adapts_and_spends_its_budget_exactly() {
+    for spp in [2, 5, 8, 16] {
+        let p = points(unbiased(spp), 0.0, |_| false);
+        assert_eq!(p.len() as u64, space().pixels() * u64::from(spp), "{spp}");
+        // Each pixel's indices are 0, 1, ... with none repeated: one sequence per pixel.
+        let mut per: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
+        for q in &p {
+            per.entry(q.pixel).or_default().push(q.index);
+        }
+        assert_eq!(per.len() as u64, space().pixels());
+        let init = (spp / 4).max(1) as usize;
+        for (pixel, mut ix) in per.clone() {
+            ix.sort_unstable();
+            assert!(
+                ix.iter().enumerate().all(|(k, &i)| k as u32 == i),
+                "{pixel:?}"
+            );
+            assert!(ix.len() >= init, "{spp} {pixel:?}: {}", ix.len());
+        }
+        if spp >= 8 {
+            // It adapts: the step's pixels get more than the flat ones.
+            let counts: HashSet<usize> = per.values().map(Vec::len).collect();
+            assert!(counts.len() > 2, "{spp}: counts {counts:?}");
+        }
+        assert!(p == points(unbiased(spp), 0.0, |_| false), "{spp}");
+    }
+}
+
+#[test]
+fn a_pilot_decides_the_adaptive_stream_alone() {
+    let pilot = || ("pilot", Values::Floats(vec![0.25]));
+    for name in ADAPTIVE {
+        let s = sampler(name, &[pilot()], 8);
+        assert_eq!(s.streams(), 2, "{name}");
+        assert_eq!(s.stream_weight(), 0.25, "{name}");
+        let base = points(sampler(name, &[pilot()], 8), 0.0, |_| false);
+        assert_eq!(base.len() as u64, space().pixels() * 8, "{name}");
+        // The adaptive stream's (odd indices) own values change: no point moves.
+        let own = points(sampler(name, &[pilot()], 8), 3.0, |q| q.index % 2 == 1);
+        assert!(sorted(&base, |_| true) == sorted(&own, |_| true), "{name}");
+        // The pilot's values change: the pilot stays, the adaptive stream follows.
+        let led = points(sampler(name, &[pilot()], 8), 3.0, |q| q.index % 2 == 0);
+        let even = |q: &SamplePoint| q.index % 2 == 0;
+        assert!(sorted(&base, even) == sorted(&led, even), "{name}");
+        assert!(sorted(&base, |_| true) != sorted(&led, |_| true), "{name}");
+        // Every pixel has both streams' samples; the pilot's are alike everywhere.
+        let mut per = vec![[0u32; 2]; space().pixels() as usize];
+        for q in &base {
+            per[space().index_of(q.pixel)][q.index as usize % 2] += 1;
+        }
+        assert!(per.iter().all(|c| c[0] == 2 && c[1] >= 1), "{name}");
+    }
+}
+
+#[test]
+fn a_pilot_and_two_streams_are_refused_together() {
+    let mut c = Choice::new(None, "gem", None);
+    let file = SourceFile::new("test", "");
+    for (p, ty, v) in [
+        ("pilot", ParamType::Float, Values::Floats(vec![0.25])),
+        ("streams", ParamType::Integer, Values::Ints(vec![2])),
+    ] {
+        c.params.push(Param::new(ty, p, v, Loc::new(&file, 0)));
+    }
+    let e = common::try_sampler_with(c, space(), 8, 7)
+        .err()
+        .expect("refused");
+    assert!(e.to_string().contains("not both"), "{e}");
+}
+
+#[test]
+fn a_split_film_blends_its_streams_with_the_pilots_weight() {
+    let mut film = Film::new(
+        FilmSettings::with_resolution(2, 1),
+        &BoxFilter::new(0.5, 0.5),
+    );
+    film.split_streams(0.25);
+    // Pixel 0: the pilot's mean 1, the adaptive stream's 5: 0.25 + 3.75. Pixel 1: the
+    // adaptive stream only, so its mean alone.
+    film.add_stream_samples(0, &[(Vec2::new(0.2, 0.5), Vec3::splat(1.0)); 2]);
+    film.add_stream_samples(
+        1,
+        &[
+            (Vec2::new(0.7, 0.5), Vec3::splat(5.0)),
+            (Vec2::new(1.5, 0.5), Vec3::splat(4.0)),
+        ],
+    );
+    assert_eq!(film.pixels(), vec![Vec3::splat(4.0), Vec3::splat(4.0)]);
+}
