@@ -1,7 +1,7 @@
 //! Adaptive sampling whose decisions never read the values they decide (issue 26, item 3):
-//! the cluster sampler's `unbiased` checkerboard, where a pixel's count comes from the other
-//! colour's first stage only, and every adaptive sampler's `pilot` stream, which alone decides
-//! where the adaptive stream's samples go.
+//! the `unbiased` checkerboard of the cluster sampler, gem and awr, where a pixel's count
+//! comes from the other colour's first stage only, and every adaptive sampler's `pilot`
+//! stream, which alone decides where the adaptive stream's samples go.
 
 mod common;
 
@@ -15,6 +15,9 @@ use glam::{Vec2, Vec3};
 use std::collections::{HashMap, HashSet};
 
 const ADAPTIVE: [&str; 4] = ["cluster", "mdas", "gem", "awr"];
+
+/// The samplers with an `unbiased` checkerboard.
+const CROSSED: [&str; 3] = ["cluster", "gem", "awr"];
 
 fn space() -> RenderingSpace {
     RenderingSpace {
@@ -61,8 +64,8 @@ fn sampler(name: &str, params: &[(&str, Values)], spp: u32) -> Box<dyn acr_plugi
     common::sampler_with(c, space(), spp, 7)
 }
 
-fn unbiased(spp: u32) -> Box<dyn acr_plugins::Sampler> {
-    sampler("cluster", &[("unbiased", Values::Bools(vec![true]))], spp)
+fn unbiased(name: &str, spp: u32) -> Box<dyn acr_plugins::Sampler> {
+    sampler(name, &[("unbiased", Values::Bools(vec![true]))], spp)
 }
 
 fn colour(q: &SamplePoint) -> u32 {
@@ -103,53 +106,68 @@ fn sorted(
 
 #[test]
 fn an_unbiased_pixels_points_do_not_depend_on_its_own_values() {
-    // The values of colour-0 pixels change: their points (how many, where) stay, since they
-    // are placed from colour-1 pixels' first stage; colour-1 pixels' points move.
-    let base = points(unbiased(8), 0.0, |_| false);
-    let changed = points(unbiased(8), 3.0, |q| colour(q) == 0);
-    // (`assert!` rather than `assert_eq!`: the point lists are long.)
-    assert!(
-        sorted(&base, |q| colour(q) == 0) == sorted(&changed, |q| colour(q) == 0),
-        "colour-0 pixels' points followed their own values"
-    );
-    assert!(
-        sorted(&base, |q| colour(q) == 1) != sorted(&changed, |q| colour(q) == 1),
-        "colour-1 pixels ignored colour-0 values"
-    );
-    // And the same the other way round.
-    let changed = points(unbiased(8), 3.0, |q| colour(q) == 1);
-    assert!(sorted(&base, |q| colour(q) == 1) == sorted(&changed, |q| colour(q) == 1));
-    // Later rounds do not learn either: values changed after the first stage move nothing.
-    let late = points(unbiased(8), 3.0, |q| q.index >= 2);
-    assert!(sorted(&base, |_| true) == sorted(&late, |_| true));
+    for name in CROSSED {
+        // The values of colour-0 pixels change: their points (how many, where) stay, since
+        // they are placed from colour-1 pixels' first stage; colour-1 pixels' points move.
+        // (`assert!` rather than `assert_eq!`: the point lists are long.)
+        let base = points(unbiased(name, 8), 0.0, |_| false);
+        let changed = points(unbiased(name, 8), 3.0, |q| colour(q) == 0);
+        assert!(
+            sorted(&base, |q| colour(q) == 0) == sorted(&changed, |q| colour(q) == 0),
+            "{name}: colour-0 pixels' points followed their own values"
+        );
+        assert!(
+            sorted(&base, |q| colour(q) == 1) != sorted(&changed, |q| colour(q) == 1),
+            "{name}: colour-1 pixels ignored colour-0 values"
+        );
+        // And the same the other way round.
+        let changed = points(unbiased(name, 8), 3.0, |q| colour(q) == 1);
+        assert!(
+            sorted(&base, |q| colour(q) == 1) == sorted(&changed, |q| colour(q) == 1),
+            "{name}"
+        );
+        // Later rounds do not learn either: values changed after the first stage move nothing.
+        let late = points(unbiased(name, 8), 3.0, |q| q.index >= 2);
+        assert!(sorted(&base, |_| true) == sorted(&late, |_| true), "{name}");
+    }
 }
 
 #[test]
-fn an_unbiased_cluster_sampler_adapts_and_spends_its_budget_exactly() {
-    for spp in [2, 5, 8, 16] {
-        let p = points(unbiased(spp), 0.0, |_| false);
-        assert_eq!(p.len() as u64, space().pixels() * u64::from(spp), "{spp}");
-        // Each pixel's indices are 0, 1, ... with none repeated: one sequence per pixel.
-        let mut per: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
-        for q in &p {
-            per.entry(q.pixel).or_default().push(q.index);
-        }
-        assert_eq!(per.len() as u64, space().pixels());
-        let init = (spp / 4).max(1) as usize;
-        for (pixel, mut ix) in per.clone() {
-            ix.sort_unstable();
-            assert!(
-                ix.iter().enumerate().all(|(k, &i)| k as u32 == i),
-                "{pixel:?}"
+fn an_unbiased_sampler_adapts_and_spends_its_budget_exactly() {
+    for name in CROSSED {
+        for spp in [2, 5, 8, 16] {
+            let p = points(unbiased(name, spp), 0.0, |_| false);
+            assert_eq!(
+                p.len() as u64,
+                space().pixels() * u64::from(spp),
+                "{name} {spp}"
             );
-            assert!(ix.len() >= init, "{spp} {pixel:?}: {}", ix.len());
+            // Each pixel's indices are 0, 1, ... with none repeated: one sequence per pixel.
+            let mut per: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
+            for q in &p {
+                per.entry(q.pixel).or_default().push(q.index);
+            }
+            assert_eq!(per.len() as u64, space().pixels());
+            // The first stage: a quarter of the budget, at least 2.
+            let init = (spp / 4).max(2).min(spp) as usize;
+            for (pixel, mut ix) in per.clone() {
+                ix.sort_unstable();
+                assert!(
+                    ix.iter().enumerate().all(|(k, &i)| k as u32 == i),
+                    "{pixel:?}"
+                );
+                assert!(ix.len() >= init, "{name} {spp} {pixel:?}: {}", ix.len());
+            }
+            if spp >= 8 {
+                // It adapts: the step's pixels get more than the flat ones.
+                let counts: HashSet<usize> = per.values().map(Vec::len).collect();
+                assert!(counts.len() > 2, "{name} {spp}: counts {counts:?}");
+            }
+            assert!(
+                p == points(unbiased(name, spp), 0.0, |_| false),
+                "{name} {spp}"
+            );
         }
-        if spp >= 8 {
-            // It adapts: the step's pixels get more than the flat ones.
-            let counts: HashSet<usize> = per.values().map(Vec::len).collect();
-            assert!(counts.len() > 2, "{spp}: counts {counts:?}");
-        }
-        assert!(p == points(unbiased(spp), 0.0, |_| false), "{spp}");
     }
 }
 
@@ -213,4 +231,39 @@ fn a_split_film_blends_its_streams_with_the_pilots_weight() {
         ],
     );
     assert_eq!(film.pixels(), vec![Vec3::splat(4.0), Vec3::splat(4.0)]);
+}
+
+#[test]
+fn an_unbiased_cluster_sampler_refuses_what_would_break_it() {
+    let refused = |params: &[(&str, Values)]| {
+        let mut c = Choice::new(None, "cluster", None);
+        let file = SourceFile::new("test", "");
+        for (p, v) in params {
+            let ty = match v {
+                Values::Bools(_) => ParamType::Bool,
+                _ => ParamType::Float,
+            };
+            c.params
+                .push(Param::new(ty, *p, v.clone(), Loc::new(&file, 0)));
+        }
+        common::try_sampler_with(c, space(), 8, 7)
+            .err()
+            .expect("refused")
+            .to_string()
+    };
+    let on = || ("unbiased", Values::Bools(vec![true]));
+    let e = refused(&[on(), ("pilot", Values::Floats(vec![0.25]))]);
+    assert!(e.contains("cannot be combined"), "{e}");
+    let e = refused(&[on(), ("evenpixels", Values::Bools(vec![false]))]);
+    assert!(e.contains("evenpixels"), "{e}");
+    // Off, with a pilot, is what a pilot means.
+    let mut c = Choice::new(None, "cluster", None);
+    let file = SourceFile::new("test", "");
+    c.params.push(Param::new(
+        ParamType::Float,
+        "pilot",
+        Values::Floats(vec![0.25]),
+        Loc::new(&file, 0),
+    ));
+    assert_eq!(common::sampler_with(c, space(), 8, 7).streams(), 2);
 }
