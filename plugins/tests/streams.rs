@@ -7,7 +7,6 @@ mod common;
 use acr_parser::{Loc, Param, ParamType, SourceFile, Values};
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::BoxFilter;
-use acr_plugins::rng::mix64;
 use acr_plugins::sampler::drive;
 use acr_plugins::{Choice, Dims, RenderingSpace, SamplePoint};
 use glam::{Vec2, Vec3};
@@ -27,21 +26,9 @@ fn space() -> RenderingSpace {
     }
 }
 
-/// A noisy step moving in time, with a bright outlier now and then: what adaptive samplers
-/// steer by. `extra` adds noise to the values of stream 0 (even indices) only.
+/// The noisy step, `extra` noise added to the values of stream 0 (even indices) only.
 fn field(q: &SamplePoint, extra: f32) -> [f32; 3] {
-    let h = mix64(u64::from(q.film[0].to_bits()) ^ mix64(u64::from(q.time.to_bits())));
-    let u = (h >> 40) as f32 / (1u64 << 24) as f32;
-    let base = if q.film[0] > 8.0 + 8.0 * q.time {
-        1.0
-    } else {
-        0.1
-    };
-    let firefly = if u > 0.97 { 20.0 } else { 0.0 };
-    let v = base + 0.2 * u + firefly;
-    let w = (h & 0xffff) as f32 / 65536.0;
-    let v = if q.index % 2 == 0 { v + extra * w } else { v };
-    [v; 3]
+    common::noisy_step(q, extra, |q| q.index % 2 == 0)
 }
 
 /// The sampler `name` with `streams` set.

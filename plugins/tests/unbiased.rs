@@ -8,7 +8,6 @@ mod common;
 use acr_parser::{Loc, Param, ParamType, SourceFile, Values};
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::BoxFilter;
-use acr_plugins::rng::mix64;
 use acr_plugins::sampler::drive;
 use acr_plugins::{Choice, Dims, RenderingSpace, SamplePoint};
 use glam::{Vec2, Vec3};
@@ -30,22 +29,6 @@ fn space() -> RenderingSpace {
             lens: false,
         },
     }
-}
-
-/// A noisy step moving in time, with a bright outlier now and then; `extra` adds noise to
-/// the samples `changed` picks.
-fn field(q: &SamplePoint, extra: f32, changed: impl Fn(&SamplePoint) -> bool) -> [f32; 3] {
-    let h = mix64(u64::from(q.film[0].to_bits()) ^ mix64(u64::from(q.time.to_bits())));
-    let u = (h >> 40) as f32 / (1u64 << 24) as f32;
-    let base = if q.film[0] > 8.0 + 8.0 * q.time {
-        1.0
-    } else {
-        0.1
-    };
-    let firefly = if u > 0.97 { 20.0 } else { 0.0 };
-    let v = base + 0.2 * u + firefly;
-    let w = (h & 0xffff) as f32 / 65536.0;
-    [if changed(q) { v + extra * w } else { v }; 3]
 }
 
 /// The sampler `name` with the parameters `params` (name, value).
@@ -89,7 +72,11 @@ fn points(
 ) -> Vec<SamplePoint> {
     drive(
         s.as_mut(),
-        |b| b.iter().map(|q| field(q, extra, changed)).collect(),
+        |b| {
+            b.iter()
+                .map(|q| common::noisy_step(q, extra, changed))
+                .collect()
+        },
         None,
     )
 }

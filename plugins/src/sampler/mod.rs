@@ -159,6 +159,19 @@ pub struct SamplerReport {
     pub rounds: Option<u64>,
 }
 
+impl SamplerReport {
+    /// The report of a sampler made of two (a pair of streams or of halves): their clusters
+    /// and rounds summed over one grid.
+    pub fn combined(a: Self, b: Self) -> Self {
+        let sum = |x: Option<u64>, y: Option<u64>| x.map(|x| x + y.unwrap_or(0));
+        Self {
+            clusters: sum(a.clusters, b.clusters),
+            cells: a.cells,
+            rounds: sum(a.rounds, b.rounds),
+        }
+    }
+}
+
 /// What every sampler is built for: the space, the command line's `--spp` and the seed.
 #[derive(Clone, Copy, Debug)]
 pub struct SamplerSetup {

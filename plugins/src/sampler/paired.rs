@@ -269,13 +269,7 @@ impl Sampler for Paired {
     }
 
     fn report(&self) -> SamplerReport {
-        let [a, b] = [self.streams[0].report(), self.streams[1].report()];
-        let sum = |x: Option<u64>, y: Option<u64>| x.map(|x| x + y.unwrap_or(0));
-        SamplerReport {
-            clusters: sum(a.clusters, b.clusters),
-            cells: a.cells,
-            rounds: sum(a.rounds, b.rounds),
-        }
+        SamplerReport::combined(self.streams[0].report(), self.streams[1].report())
     }
 
     fn reconstructs(&self) -> bool {

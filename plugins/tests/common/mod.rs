@@ -97,3 +97,22 @@ pub fn render_field(
         )
     })
 }
+
+/// A noisy step moving in time, with a bright outlier now and then: what adaptive samplers
+/// steer by. `extra` adds noise to the values of the samples `changed` picks.
+#[allow(dead_code)]
+pub fn noisy_step(q: &SamplePoint, extra: f32, changed: impl Fn(&SamplePoint) -> bool) -> [f32; 3] {
+    let h = acr_plugins::rng::mix64(
+        u64::from(q.film[0].to_bits()) ^ acr_plugins::rng::mix64(u64::from(q.time.to_bits())),
+    );
+    let u = (h >> 40) as f32 / (1u64 << 24) as f32;
+    let base = if q.film[0] > 8.0 + 8.0 * q.time {
+        1.0
+    } else {
+        0.1
+    };
+    let firefly = if u > 0.97 { 20.0 } else { 0.0 };
+    let v = base + 0.2 * u + firefly;
+    let w = (h & 0xffff) as f32 / 65536.0;
+    [if changed(q) { v + extra * w } else { v }; 3]
+}

@@ -124,12 +124,6 @@ impl Sampler for Crossed {
     }
 
     fn report(&self) -> SamplerReport {
-        let [a, b] = [self.halves[0].report(), self.halves[1].report()];
-        let sum = |x: Option<u64>, y: Option<u64>| x.map(|x| x + y.unwrap_or(0));
-        SamplerReport {
-            clusters: sum(a.clusters, b.clusters),
-            cells: a.cells,
-            rounds: sum(a.rounds, b.rounds),
-        }
+        SamplerReport::combined(self.halves[0].report(), self.halves[1].report())
     }
 }
