@@ -16,6 +16,50 @@ use crate::sampler::{Sampler, SamplerReport};
 use crate::space::SamplePoint;
 use std::collections::VecDeque;
 
+impl ClusterSampler {
+    /// This sampler as the half of an unbiased pair ([`Crossed`]) that places the
+    /// adaptive samples of the pixels of colour `colour` (0 or 1): its budget is theirs.
+    pub(super) fn for_colour(mut self, colour: u32) -> Self {
+        self.settings.colour = Some(colour);
+        self.remaining = self.adaptive_budget();
+        self
+    }
+
+    /// The samples its rounds are to give: what the first stage leaves of the budget of the
+    /// pixels it places (those of its colour, in an unbiased pair).
+    pub(super) fn adaptive_budget(&self) -> u64 {
+        let pixels = self.space.pixels();
+        let own = match self.settings.colour {
+            None => pixels,
+            Some(0) => pixels.div_ceil(2),
+            Some(_) => pixels / 2,
+        };
+        own * u64::from(self.settings.spp - self.settings.init_spp)
+    }
+}
+
+/// The pixel (column, row from the space's corner) of colour `colour` nearest `(col, row)`:
+/// itself, or its partner in the same row (the column's lowest bit flipped, or the column
+/// before at an odd width's last one), or in a one-column space the same in the column.
+#[inline]
+pub(super) fn own_colour(col: u32, row: u32, colour: u32, width: u32, height: u32) -> (u32, u32) {
+    if (col + row) & 1 == colour {
+        return (col, row);
+    }
+    let partner = |v: u32, n: u32| {
+        if v ^ 1 < n {
+            v ^ 1
+        } else {
+            v.saturating_sub(1)
+        }
+    };
+    if width > 1 {
+        (partner(col, width), row)
+    } else {
+        (col, partner(row, height))
+    }
+}
+
 /// Two cluster samplers, one per pixel colour, each placing its colour's samples from the
 /// other colour's first stage.
 pub struct Crossed {
@@ -125,5 +169,26 @@ impl Sampler for Crossed {
 
     fn report(&self) -> SamplerReport {
         SamplerReport::combined(self.halves[0].report(), self.halves[1].report())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::own_colour;
+
+    #[test]
+    fn every_pixel_has_a_partner_of_the_other_colour_beside_it() {
+        for (w, h) in [(1, 2), (1, 5), (2, 1), (3, 3), (4, 3), (7, 2)] {
+            for row in 0..h {
+                for col in 0..w {
+                    for colour in 0..2 {
+                        let (c, r) = own_colour(col, row, colour, w, h);
+                        assert_eq!((c + r) & 1, colour, "{w}x{h} ({col}, {row})");
+                        assert!(c < w && r < h);
+                        assert!(c.abs_diff(col) + r.abs_diff(row) <= 1);
+                    }
+                }
+            }
+        }
     }
 }

@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 mod crossed;
 mod noise;
+use crossed::own_colour;
 mod settings;
 #[cfg(test)]
 use settings::build;
@@ -171,26 +172,6 @@ impl ClusterSampler {
             partition: None,
             noise: None,
         }
-    }
-
-    /// This sampler as the half of an unbiased pair ([`crossed::Crossed`]) that places the
-    /// adaptive samples of the pixels of colour `colour` (0 or 1): its budget is theirs.
-    fn for_colour(mut self, colour: u32) -> Self {
-        self.settings.colour = Some(colour);
-        self.remaining = self.adaptive_budget();
-        self
-    }
-
-    /// The samples its rounds are to give: what the first stage leaves of the budget of the
-    /// pixels it places (those of its colour, in an unbiased pair).
-    fn adaptive_budget(&self) -> u64 {
-        let pixels = self.space.pixels();
-        let own = match self.settings.colour {
-            None => pixels,
-            Some(0) => pixels.div_ceil(2),
-            Some(_) => pixels / 2,
-        };
-        own * u64::from(self.settings.spp - self.settings.init_spp)
     }
 
     /// The settings in force (after `minspp` raised `initspp` where needed).
@@ -843,28 +824,6 @@ impl Sampler for ClusterSampler {
             cells: Some(self.grid.len() as u64),
             rounds: Some(self.rounds),
         }
-    }
-}
-
-/// The pixel (column, row from the space's corner) of colour `colour` nearest `(col, row)`:
-/// itself, or its partner in the same row (the column's lowest bit flipped, or the column
-/// before at an odd width's last one), or in a one-column space the same in the column.
-#[inline]
-pub(crate) fn own_colour(col: u32, row: u32, colour: u32, width: u32, height: u32) -> (u32, u32) {
-    if (col + row) & 1 == colour {
-        return (col, row);
-    }
-    let partner = |v: u32, n: u32| {
-        if v ^ 1 < n {
-            v ^ 1
-        } else {
-            v.saturating_sub(1)
-        }
-    };
-    if width > 1 {
-        (partner(col, width), row)
-    } else {
-        (col, partner(row, height))
     }
 }
 
