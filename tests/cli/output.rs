@@ -255,15 +255,25 @@ fn every_sampler_gives_the_same_file_with_one_and_two_threads() {
     // Large enough for several cluster rounds, each planned while the one before is traced.
     let dir = TempDir::new("samplers");
     let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 64, 48));
-    for sampler in ["random", "stratified", "halton", "sobol", "cluster"] {
+    // The cluster sampler twice: unbiased (its default) and as published.
+    let published = ["--set", "sampler.unbiased=false"];
+    let runs: [(&str, &[&str]); 6] = [
+        ("random", &[]),
+        ("stratified", &[]),
+        ("halton", &[]),
+        ("sobol", &[]),
+        ("cluster", &[]),
+        ("cluster", &published),
+    ];
+    for (k, (sampler, extra)) in runs.into_iter().enumerate() {
         let run = |threads: &str| {
             let (out, stats) = (
-                dir.join(format!("{sampler}{threads}.exr")),
-                dir.join(format!("{sampler}{threads}.json")),
+                dir.join(format!("{sampler}{k}-{threads}.exr")),
+                dir.join(format!("{sampler}{k}-{threads}.json")),
             );
             let args = ["--spp", "8", "--sampler", sampler, "--threads", threads];
             let stats_arg = ["--stats", stats.to_str().unwrap()];
-            render_ok(&scene, &out, &[&args[..], &stats_arg[..]].concat());
+            render_ok(&scene, &out, &[&args[..], &stats_arg[..], extra].concat());
             if sampler == "cluster" {
                 let rounds = read_stats(&stats)["rounds"].as_u64().unwrap();
                 assert!(rounds > 2, "{rounds} rounds");
