@@ -254,3 +254,48 @@ fn an_unbiased_cluster_sampler_refuses_what_would_break_it() {
     ));
     assert_eq!(common::sampler_with(c, space(), 8, 7).streams(), 2);
 }
+
+#[test]
+fn a_halted_unbiased_cluster_sampler_ends_both_colours_at_the_same_pass() {
+    // Large enough for a first stage of many batches, so that the halt comes between a
+    // batch of one half and its mate from the other.
+    let space = RenderingSpace {
+        x1: 200,
+        y1: 100,
+        ..space()
+    };
+    for halt_after in [1, 2, 3, 4, 7] {
+        let mut c = Choice::new(None, "cluster", None);
+        let file = SourceFile::new("test", "");
+        c.params.push(Param::new(
+            ParamType::Bool,
+            "unbiased",
+            Values::Bools(vec![true]),
+            Loc::new(&file, 0),
+        ));
+        let mut s = common::sampler_with(c, space, 64, 7);
+        let p = drive(
+            s.as_mut(),
+            |b| {
+                b.iter()
+                    .map(|q| common::noisy_step(q, 0.0, |_| false))
+                    .collect()
+            },
+            Some(halt_after),
+        );
+        let mut per = vec![0u32; space.pixels() as usize];
+        for q in &p {
+            per[space.index_of(q.pixel)] += 1;
+        }
+        let counts: HashSet<u32> = per.iter().copied().collect();
+        assert_eq!(
+            counts.len(),
+            1,
+            "halted after {halt_after}: counts {counts:?}"
+        );
+        assert!(
+            p.len() < space.pixels() as usize * 16,
+            "{halt_after}: not halted"
+        );
+    }
+}

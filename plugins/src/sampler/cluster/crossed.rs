@@ -71,6 +71,10 @@ pub struct Crossed {
     turn: usize,
     /// Halves whose budget is spent.
     done: [bool; 2],
+    /// The half that gave the last batch.
+    last: Option<usize>,
+    /// A half to halt once it has given its next batch (see [`Sampler::halt`]).
+    halt_after_next: Option<usize>,
 }
 
 impl Crossed {
@@ -84,6 +88,8 @@ impl Crossed {
             given: VecDeque::new(),
             turn: 0,
             done: [false; 2],
+            last: None,
+            halt_after_next: None,
         }
     }
 }
@@ -119,6 +125,11 @@ impl Sampler for Crossed {
                     out.retain(|q| (q.pixel[0] - x0 + q.pixel[1] - y0) & 1 == colour);
                 }
                 self.given.push_back((h, first_stage));
+                self.last = Some(h);
+                if self.halt_after_next == Some(h) {
+                    self.halves[h].halt();
+                    self.halt_after_next = None;
+                }
                 return true;
             }
             self.done[h] = true;
@@ -138,8 +149,16 @@ impl Sampler for Crossed {
     }
 
     fn halt(&mut self) {
-        for h in &mut self.halves {
-            h.halt();
+        // The halves' batches pair up (the first's, then the second's over the same pixels).
+        // When the first has given a batch whose mate is still to come, the second halts after
+        // giving it, so that both end the same pass and every pixel has as many samples.
+        if self.last == Some(0) && !self.done[1] {
+            self.halves[0].halt();
+            self.halt_after_next = Some(1);
+        } else {
+            for h in &mut self.halves {
+                h.halt();
+            }
         }
     }
 
