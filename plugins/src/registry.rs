@@ -340,6 +340,20 @@ impl Setting {
     }
 }
 
+/// An error with `message` at the first of the parameters `names` that is given, or, when none
+/// is, in `context` (what chose the values: `--spp`, the plugin).
+pub(crate) fn error_at_param(
+    params: &ParamList,
+    names: &[&str],
+    context: &str,
+    message: impl Into<String>,
+) -> Error {
+    match names.iter().find_map(|n| params.get(n)) {
+        Some(p) => Error::at(&p.loc, message),
+        None => Error::file(context, message),
+    }
+}
+
 /// A float parameter that must lie in `range`, or an error at its location.
 pub(crate) fn float_in(
     params: &ParamList,

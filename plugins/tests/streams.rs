@@ -4,11 +4,11 @@
 
 mod common;
 
-use acr_parser::{Loc, Param, ParamType, SourceFile, Values};
+use acr_parser::Values;
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::BoxFilter;
 use acr_plugins::sampler::drive;
-use acr_plugins::{Choice, Dims, RenderingSpace, SamplePoint};
+use acr_plugins::{Dims, RenderingSpace, SamplePoint};
 use glam::{Vec2, Vec3};
 
 const ADAPTIVE: [&str; 4] = ["cluster", "mdas", "gem", "awr"];
@@ -33,14 +33,7 @@ fn field(q: &SamplePoint, extra: f32) -> [f32; 3] {
 
 /// The sampler `name` with `streams` set.
 fn with_streams(name: &str, streams: i32, spp: u32) -> Box<dyn acr_plugins::Sampler> {
-    let mut c = Choice::new(None, name, None);
-    let file = SourceFile::new("test", "");
-    c.params.push(Param::new(
-        ParamType::Integer,
-        "streams",
-        Values::Ints(vec![streams]),
-        Loc::new(&file, 0),
-    ));
+    let c = common::choice(name, &[("streams", Values::Ints(vec![streams]))]);
     common::sampler_with(c, space(), spp, 7)
 }
 

@@ -5,11 +5,11 @@
 
 mod common;
 
-use acr_parser::{Loc, Param, ParamType, SourceFile, Values};
+use acr_parser::Values;
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::BoxFilter;
 use acr_plugins::sampler::drive;
-use acr_plugins::{Choice, Dims, RenderingSpace, SamplePoint};
+use acr_plugins::{Dims, RenderingSpace, SamplePoint};
 use glam::{Vec2, Vec3};
 use std::collections::{HashMap, HashSet};
 
@@ -33,18 +33,7 @@ fn space() -> RenderingSpace {
 
 /// The sampler `name` with the parameters `params` (name, value).
 fn sampler(name: &str, params: &[(&str, Values)], spp: u32) -> Box<dyn acr_plugins::Sampler> {
-    let mut c = Choice::new(None, name, None);
-    let file = SourceFile::new("test", "");
-    for (p, v) in params {
-        let ty = match v {
-            Values::Bools(_) => ParamType::Bool,
-            Values::Floats(_) => ParamType::Float,
-            _ => ParamType::Integer,
-        };
-        c.params
-            .push(Param::new(ty, *p, v.clone(), Loc::new(&file, 0)));
-    }
-    common::sampler_with(c, space(), spp, 7)
+    common::sampler_with(common::choice(name, params), space(), spp, 7)
 }
 
 fn unbiased(name: &str, spp: u32) -> Box<dyn acr_plugins::Sampler> {
@@ -186,14 +175,13 @@ fn a_pilot_decides_the_adaptive_stream_alone() {
 
 #[test]
 fn a_pilot_and_two_streams_are_refused_together() {
-    let mut c = Choice::new(None, "gem", None);
-    let file = SourceFile::new("test", "");
-    for (p, ty, v) in [
-        ("pilot", ParamType::Float, Values::Floats(vec![0.25])),
-        ("streams", ParamType::Integer, Values::Ints(vec![2])),
-    ] {
-        c.params.push(Param::new(ty, p, v, Loc::new(&file, 0)));
-    }
+    let c = common::choice(
+        "gem",
+        &[
+            ("pilot", Values::Floats(vec![0.25])),
+            ("streams", Values::Ints(vec![2])),
+        ],
+    );
     let e = common::try_sampler_with(c, space(), 8, 7)
         .err()
         .expect("refused");
@@ -223,16 +211,7 @@ fn a_split_film_blends_its_streams_with_the_pilots_weight() {
 #[test]
 fn an_unbiased_cluster_sampler_refuses_what_would_break_it() {
     let refused = |params: &[(&str, Values)]| {
-        let mut c = Choice::new(None, "cluster", None);
-        let file = SourceFile::new("test", "");
-        for (p, v) in params {
-            let ty = match v {
-                Values::Bools(_) => ParamType::Bool,
-                _ => ParamType::Float,
-            };
-            c.params
-                .push(Param::new(ty, *p, v.clone(), Loc::new(&file, 0)));
-        }
+        let c = common::choice("cluster", params);
         common::try_sampler_with(c, space(), 8, 7)
             .err()
             .expect("refused")
@@ -244,14 +223,7 @@ fn an_unbiased_cluster_sampler_refuses_what_would_break_it() {
     let e = refused(&[on(), ("evenpixels", Values::Bools(vec![false]))]);
     assert!(e.contains("evenpixels"), "{e}");
     // Off, with a pilot, is what a pilot means.
-    let mut c = Choice::new(None, "cluster", None);
-    let file = SourceFile::new("test", "");
-    c.params.push(Param::new(
-        ParamType::Float,
-        "pilot",
-        Values::Floats(vec![0.25]),
-        Loc::new(&file, 0),
-    ));
+    let c = common::choice("cluster", &[("pilot", Values::Floats(vec![0.25]))]);
     assert_eq!(common::sampler_with(c, space(), 8, 7).streams(), 2);
 }
 
@@ -265,14 +237,7 @@ fn a_halted_unbiased_cluster_sampler_ends_both_colours_at_the_same_pass() {
         ..space()
     };
     for halt_after in [1, 2, 3, 4, 7] {
-        let mut c = Choice::new(None, "cluster", None);
-        let file = SourceFile::new("test", "");
-        c.params.push(Param::new(
-            ParamType::Bool,
-            "unbiased",
-            Values::Bools(vec![true]),
-            Loc::new(&file, 0),
-        ));
+        let c = common::choice("cluster", &[("unbiased", Values::Bools(vec![true]))]);
         let mut s = common::sampler_with(c, space, 64, 7);
         let p = drive(
             s.as_mut(),

@@ -17,7 +17,7 @@ use super::{pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, Sa
 use crate::cluster::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
-use crate::registry::{float_in, int_in, Choice, ParamSpec};
+use crate::registry::{error_at_param, float_in, int_in, Choice, ParamSpec};
 use crate::space::SamplePoint;
 use acr_parser::{Param, ParamType, Result, Values};
 use std::collections::VecDeque;
@@ -43,7 +43,7 @@ pub(crate) const PILOT: ParamSpec = ParamSpec::new(
 );
 
 /// Per-pixel count parameters that each stream takes half of.
-const HALVED: [(&str, i32); 2] = [("initspp", 1), ("minspp", 0)];
+const HALVED: [(&str, u32); 2] = [("initspp", 1), ("minspp", 0)];
 
 /// Builds the sampler of `build` as a pilot and an adaptive stream when its `pilot` share is
 /// above 0, as two streams when its `streams` parameter is 2, and as one otherwise (the
@@ -57,12 +57,13 @@ pub(crate) fn wrap(
     let pilot = float_in(&c.params, "pilot", 0.0, 0.0..=0.9)?;
     let spp = pixel_samples(&c.params, setup)?;
     if pilot > 0.0 && streams == 2 {
-        let p = c.params.get("pilot").or_else(|| c.params.get("streams"));
         let message = "a sampler takes a pilot stream or two streams, not both";
-        return Err(match p {
-            Some(p) => acr_parser::Error::at(&p.loc, message),
-            None => acr_parser::Error::file("sampler", message),
-        });
+        return Err(error_at_param(
+            &c.params,
+            &["pilot", "streams"],
+            "sampler",
+            message,
+        ));
     }
     if spp < 2 || (streams == 1 && pilot == 0.0) {
         return build(c, setup);
@@ -75,18 +76,9 @@ pub(crate) fn wrap(
     for (s, &share) in shares.iter().enumerate() {
         let mut choice = c.clone();
         for (name, least) in HALVED {
-            let Some(p) = c.params.get(name) else {
-                continue;
-            };
-            // Out-of-range values are left for the sampler to report.
-            if let Values::Ints(v) = &p.values {
-                if let [v] = v[..] {
-                    if (least..=spp as i32).contains(&v) {
-                        let half = ((v + 1 - s as i32) / 2).clamp(least, share as i32);
-                        let q = Param::new(p.ty, name, Values::Ints(vec![half]), p.loc.clone());
-                        choice.params.push(q);
-                    }
-                }
+            if let Some(v) = given_count(c, name, least..=spp) {
+                let half = ((v + 1 - s as u32) / 2).clamp(least, share);
+                choice = with_int(&choice, name, half);
             }
         }
         built.push(build(&choice, &stream_setup(setup, s as u32, share))?);
@@ -108,6 +100,18 @@ fn stream_setup(setup: &SamplerSetup, which: u32, spp: u32) -> SamplerSetup {
         // The film collects each stream's cells: the sampler's hold the other stream's values.
         reconstruction_reads_cells: false,
         ..*setup
+    }
+}
+
+/// The one integer value of parameter `name` of `c` when given and within `range`; values out
+/// of range are left for the sampler to report.
+fn given_count(c: &Choice, name: &str, range: std::ops::RangeInclusive<u32>) -> Option<u32> {
+    match c.params.get(name).map(|p| &p.values) {
+        Some(Values::Ints(v)) => match v[..] {
+            [v] => u32::try_from(v).ok().filter(|v| range.contains(v)),
+            _ => None,
+        },
+        _ => None,
     }
 }
 
@@ -148,16 +152,10 @@ fn with_pilot(
     // count the user asked for is met by both streams together.
     let rest = spp - first;
     let mut adaptive_choice = with_int(c, "initspp", 1);
-    if let Some(Values::Ints(v)) = c.params.get("minspp").map(|p| &p.values) {
-        // Out-of-range values are left for the sampler to report.
-        if let [v] = v[..] {
-            if (0..=spp as i32).contains(&v) {
-                let least = v as u32;
-                pilot_choice = with_int(&pilot_choice, "minspp", least.min(first));
-                let left = least.saturating_sub(first);
-                adaptive_choice = with_int(&adaptive_choice, "minspp", left);
-            }
-        }
+    if let Some(least) = given_count(c, "minspp", 0..=spp) {
+        pilot_choice = with_int(&pilot_choice, "minspp", least.min(first));
+        let left = least.saturating_sub(first);
+        adaptive_choice = with_int(&adaptive_choice, "minspp", left);
     }
     let pilot_stream = build(&pilot_choice, &stream_setup(setup, 0, first))?;
     let adaptive = build(&adaptive_choice, &stream_setup(setup, 1, rest))?;

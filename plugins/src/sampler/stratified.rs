@@ -193,16 +193,17 @@ fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
         None => (xs, ys),
     };
     if u64::from(xs) * u64::from(ys) > u64::from(super::MAX_SPP) {
-        let loc = c.params.get("xsamples").map(|p| p.loc.clone());
         let message = format!(
             "xsamples x ysamples = {} is over {}",
             u64::from(xs) * u64::from(ys),
             super::MAX_SPP
         );
-        return Err(match loc {
-            Some(l) => acr_parser::Error::at(&l, message),
-            None => acr_parser::Error::file("--spp", message),
-        });
+        return Err(crate::registry::error_at_param(
+            &c.params,
+            &["xsamples"],
+            "--spp",
+            message,
+        ));
     }
     Ok(Box::new(StratifiedSampler::new(
         setup.space,

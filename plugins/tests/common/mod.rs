@@ -116,3 +116,22 @@ pub fn noisy_step(q: &SamplePoint, extra: f32, changed: impl Fn(&SamplePoint) ->
     let w = (h & 0xffff) as f32 / 65536.0;
     [if changed(q) { v + extra * w } else { v }; 3]
 }
+
+/// The choice of plugin `name` with the parameters `params` (name and values, typed by the
+/// values: bools, floats, else integers), as a scene would give them.
+#[allow(dead_code)]
+pub fn choice(name: &str, params: &[(&str, acr_parser::Values)]) -> Choice {
+    use acr_parser::{Loc, Param, ParamType, SourceFile, Values};
+    let mut c = Choice::new(None, name, None);
+    let file = SourceFile::new("test", "");
+    for (p, v) in params {
+        let ty = match v {
+            Values::Bools(_) => ParamType::Bool,
+            Values::Floats(_) => ParamType::Float,
+            _ => ParamType::Integer,
+        };
+        c.params
+            .push(Param::new(ty, *p, v.clone(), Loc::new(&file, 0)));
+    }
+    c
+}

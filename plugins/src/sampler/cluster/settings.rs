@@ -3,9 +3,11 @@
 
 use super::ClusterSampler;
 use crate::cluster::build::ClusterParams;
-use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
+use crate::registry::{
+    error_at_param, float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo,
+};
 use crate::sampler::{IndexStream, Sampler, SamplerBuild, SamplerSetup};
-use acr_parser::{Error, ParamType, Result};
+use acr_parser::{ParamType, Result};
 
 /// How the next clusters to sample are chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -252,12 +254,8 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
     let whole = setup.stream == IndexStream::ALL;
     let unbiased = p.bool_or("unbiased", whole)? && setup.space.pixels() > 1;
     if unbiased && !whole {
-        let loc = p.get("unbiased").map(|x| x.loc.clone());
         let message = "unbiased cannot be combined with a pilot or two streams";
-        return Err(match loc {
-            Some(l) => Error::at(&l, message),
-            None => Error::file("cluster sampler", message),
-        });
+        return Err(error_at_param(p, &["unbiased"], "cluster sampler", message));
     }
     if unbiased {
         // Decisions read the first stage alone: two samples per pixel at least, so that each
@@ -295,27 +293,26 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
             * f64::from(s.bins).powi(setup.space.dims.count() as i32 - 2)
     };
     if grid_cells > MAX_CELLS as f64 {
-        let loc = p
-            .get("cellsize")
-            .or_else(|| p.get("bins"))
-            .map(|x| x.loc.clone());
         let message = format!(
             "the cluster sampler's grid would have {grid_cells:.0} cells (most {MAX_CELLS}); \
              raise cellsize or lower bins"
         );
-        return Err(match loc {
-            Some(l) => Error::at(&l, message),
-            None => Error::file("cluster sampler", message),
-        });
+        return Err(error_at_param(
+            p,
+            &["cellsize", "bins"],
+            "cluster sampler",
+            message,
+        ));
     }
     if unbiased {
         if !s.even_pixels {
-            let loc = p.get("evenpixels").map(|x| x.loc.clone());
             let message = "unbiased needs evenpixels: a pixel's points must be its own sequence";
-            return Err(match loc {
-                Some(l) => Error::at(&l, message),
-                None => Error::file("cluster sampler", message),
-            });
+            return Err(error_at_param(
+                p,
+                &["evenpixels"],
+                "cluster sampler",
+                message,
+            ));
         }
         // Neither half's cells are what the reconstruction reads: the film collects them.
         s.keep_radiance = false;
