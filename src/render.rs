@@ -92,6 +92,10 @@ pub struct Stop<'a> {
     /// Samples per pixel before the noise threshold is looked at (at least 2: the error
     /// estimate needs a variance).
     pub min_spp: u32,
+    /// With a time limit, tell the sampler after every batch how many samples per pixel fit
+    /// in the time left at the speed so far ([`Sampler::plan_for`]), so that an adaptive
+    /// sampler plans its stages for the time rather than for its budget.
+    pub plan_to_time: bool,
 }
 
 impl Stop<'_> {
@@ -365,6 +369,8 @@ pub fn render_with(
     let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     let last_pixel = space.pixel(space.pixels().saturating_sub(1));
     let in_passes = sampler.whole_passes();
+    // Set once the sampler planned for fewer samples than its budget to end in the time.
+    let mut planned_short = false;
     let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
     while more {
         // While `batch` is traced, the sampler and the film take the batch before and, when
@@ -414,6 +420,15 @@ pub fn render_with(
                 }
             }
         }
+        if let (Some(limit), true, None) = (stop.time_limit, stop.plan_to_time, counts.halted_by) {
+            // From one sample per pixel on, the speed so far is a fair guess of the rest.
+            if counts.samples >= pixels {
+                let spp = spp_in_time(counts.samples, pixels, start.elapsed(), limit);
+                if spp < sampler.spp() && sampler.plan_for(spp) {
+                    planned_short = true;
+                }
+            }
+        }
         match planned {
             Some(planned) => {
                 std::mem::swap(&mut batch, &mut next);
@@ -432,6 +447,9 @@ pub fn render_with(
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
     if !counts.halted {
         counts.halted_by = None;
+    } else if counts.halted_by.is_none() && planned_short {
+        // It ended as planned, the time spent.
+        counts.halted_by = Some(Halt::Time);
     } else if counts.halted_by.is_none() && stop.noise_threshold.is_some() {
         // A sampler that stops where it is settled ended by itself, everywhere settled.
         counts.halted_by = Some(Halt::Noise);
@@ -440,9 +458,30 @@ pub fn render_with(
     counts
 }
 
+/// The samples per pixel that fit in `limit` when `samples` over `pixels` took `elapsed`:
+/// those given and, at the same speed, those of the time left.
+fn spp_in_time(samples: u64, pixels: u64, elapsed: Duration, limit: Duration) -> u32 {
+    let spent = elapsed.as_secs_f64().max(1e-6);
+    let left = limit.saturating_sub(elapsed).as_secs_f64();
+    let total = samples as f64 * (1.0 + left / spent);
+    (total / pixels.max(1) as f64)
+        .ceil()
+        .min(f64::from(u32::MAX)) as u32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_samples_that_fit_follow_the_speed_so_far() {
+        let s = Duration::from_secs_f64;
+        // 1,000 samples over 100 pixels in 1 s: 20 spp more fit in 2 s more.
+        assert_eq!(spp_in_time(1000, 100, s(1.0), s(3.0)), 30);
+        // Past the limit, only what was given.
+        assert_eq!(spp_in_time(1000, 100, s(4.0), s(3.0)), 10);
+        assert_eq!(spp_in_time(0, 100, s(0.0), s(3.0)), 0);
+    }
     use acr_plugins::PixelStats;
 
     #[test]

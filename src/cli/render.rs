@@ -20,6 +20,16 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
+/// What an adaptive sampler plans for under `--time-limit`.
+#[derive(clap::ValueEnum, serde::Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum TimePlan {
+    /// The samples per pixel that fit in the time left, at the speed so far.
+    Fit,
+    /// Its budget (`--spp`), as without a limit.
+    Budget,
+}
+
 /// Arguments of `acr render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
@@ -36,6 +46,12 @@ pub struct RenderArgs {
     /// pixel keeps as many samples as the others); --spp or the scene's budget still caps it.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
+    /// With --time-limit, what an adaptive sampler plans its stages for: `fit`, the samples
+    /// per pixel its speed so far says fit in the time left (measured again after every
+    /// batch; --spp still caps it), or `budget`, --spp as without a limit (the limit only
+    /// stops it, maybe inside its first stage).
+    #[arg(long, value_enum, default_value_t = TimePlan::Fit, requires = "time_limit")]
+    pub time_plan: TimePlan,
     /// Stop once the image's estimated relative error (the mean over pixels of the standard
     /// error of the pixel's luminance over its mean + 0.01) is below T, at the end of the pass
     /// under way; --spp or the scene's budget still caps it. Any sampler.
@@ -483,6 +499,7 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         time_limit: args.time_limit.map(std::time::Duration::from_secs_f64),
         noise_threshold: args.noise_threshold,
         min_spp: args.min_spp,
+        plan_to_time: args.time_plan == TimePlan::Fit,
         interrupt: Some(&interrupted),
         checkpoints,
     };

@@ -203,6 +203,11 @@ fn unknown_plugins_and_parameters_are_located_errors_with_the_closest_name() {
         (&["--aov", "sp=a.png"], &["unknown AOV", "\"spp\""]),
         (&["--time-limit", "0"], &["positive number of seconds"]),
         (&["--time-limit", "nan"], &["positive number of seconds"]),
+        (&["--time-plan", "budget"], &["--time-limit"]),
+        (
+            &["--time-limit", "1", "--time-plan", "soon"],
+            &["possible values: fit, budget"],
+        ),
         // The renders that measure the sampler's cost cannot stop where the first one did.
         (
             &["--time-limit", "1", "--sampler-cost"],

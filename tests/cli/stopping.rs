@@ -98,3 +98,46 @@ fn a_time_limit_stops_at_a_whole_pass_and_the_image_stays_complete() {
     let lit = img.pixels.iter().filter(|c| c.max_element() > 0.0).count();
     assert!(lit > 200 * 200 * 9 / 10, "{lit} lit pixels");
 }
+
+/// A time limit that adapts (issue 26, item 4): with `--spp 1024` the cluster sampler's first
+/// stage would be 256 spp, longer than the limit, so planned for its budget it never adapts;
+/// planned for what its speed says fits (`--time-plan fit`, the default) it ends its first
+/// stage early, adapts in rounds, and stops in the time with every pixel sampled twice or more.
+#[test]
+fn a_time_limit_plans_the_adaptive_sampler_for_what_fits() {
+    let dir = TempDir::new("timeplan");
+    let scene = dir.write("t.pbrt", &example_scene("cornell-box.pbrt", 200, 200));
+    let run = |plan: &str| {
+        let (out, stats, spp) = (dir.join("t.exr"), dir.join("t.json"), dir.join("spp.exr"));
+        let spp_aov = format!("spp={}", spp.display());
+        let args = [
+            "--sampler",
+            "cluster",
+            "--spp",
+            "1024",
+            "--time-limit",
+            "3",
+            "--time-plan",
+            plan,
+            "--aov",
+            &spp_aov,
+            "--stats",
+            stats.to_str().unwrap(),
+        ];
+        render_ok(&scene, &out, &args);
+        let least = read_image(&spp, false)
+            .unwrap()
+            .pixels
+            .iter()
+            .map(|c| c.x)
+            .fold(f32::INFINITY, f32::min);
+        (read_stats(&stats), least)
+    };
+    let (fit, least) = run("fit");
+    assert_eq!(fit["halted_by"], "time");
+    assert!(fit["rounds"].as_u64().unwrap() > 0, "{}", fit["rounds"]);
+    assert!(least >= 2.0, "{least} spp");
+    let (budget, _) = run("budget");
+    assert_eq!(budget["halted_by"], "time");
+    assert_eq!(budget["rounds"], 0);
+}

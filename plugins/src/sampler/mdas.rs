@@ -15,7 +15,10 @@
 // Channel and dim loops index several small arrays at once, as the formulas do.
 #![allow(clippy::needless_range_loop)]
 
-use super::{pixel_key, Pcg32, Sampler, SamplerBuild, SamplerReport, SamplerSetup, BATCH_SAMPLES};
+use super::{
+    pixel_key, Pcg32, PixelCursor, Sampler, SamplerBuild, SamplerReport, SamplerSetup,
+    BATCH_SAMPLES,
+};
 use crate::cluster::grid::MAX_DIMS;
 use crate::film::{luminance, Film, Spectrum};
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
@@ -68,7 +71,13 @@ pub struct MdasSampler {
     space: RenderingSpace,
     dims: usize,
     spp: u32,
-    init_spp: u32,
+    /// The samples per pixel it plans for: `spp`, or fewer under a time plan.
+    plan_spp: u32,
+    /// The first, uniform round's walk, pass by pass over every pixel (its count is the
+    /// first round's `initspp`, which a time plan may shorten).
+    first: PixelCursor,
+    /// Whether `initspp` was given (then a time plan keeps it).
+    init_given: bool,
     seed: u64,
     /// Which interleaved stream of sample indices it gives.
     stream: super::IndexStream,
@@ -80,8 +89,6 @@ pub struct MdasSampler {
     /// Points of the round under way, sorted by row, not yet given out.
     pending: Vec<SamplePoint>,
     pending_at: usize,
-    /// Pixels of the first round given out so far.
-    init_cursor: u64,
     /// Samples given out.
     given: u64,
     /// Sample indices given per pixel.
@@ -96,7 +103,18 @@ pub struct MdasSampler {
 
 impl MdasSampler {
     fn budget(&self) -> u64 {
-        self.space.pixels() * u64::from(self.spp)
+        self.space.pixels() * u64::from(self.plan_spp)
+    }
+
+    /// The first round's points: its count (which a time plan may have shortened) per pixel.
+    fn first_round(&self) -> u64 {
+        self.space.pixels() * u64::from(self.first.spp())
+    }
+
+    /// Splits the first round's samples, held in the root, into a tree.
+    fn build_tree(&mut self) {
+        self.built = true;
+        self.split_if_full(0);
     }
 
     /// A point's coordinates in the tree's space.
@@ -297,7 +315,11 @@ impl MdasSampler {
 
     /// Plans the next adaptive round into `pending`; false when the budget is spent.
     fn plan_round(&mut self) -> bool {
-        let left = self.budget() - self.given;
+        // A first round halted at a pass is all seen by now: split it for the reconstruction.
+        if !self.built && self.halted {
+            self.build_tree();
+        }
+        let left = self.budget().saturating_sub(self.given);
         if left == 0 || self.halted {
             return false;
         }
@@ -376,32 +398,29 @@ impl MdasSampler {
         self.pending_at = 0;
     }
 
-    /// The first round's points for the next pixels: `init_spp` uniform points each.
+    /// The first round's next batch: a pass (or part of one) of uniform points.
     fn init_batch(&mut self) -> bool {
-        let pixels = self.space.pixels();
-        if self.init_cursor >= pixels {
+        let Some((pixels, indices)) = self.first.next() else {
             return false;
-        }
-        let per = u64::from(self.init_spp);
-        let end = (self.init_cursor + (BATCH_SAMPLES / per).max(1)).min(pixels);
-        let mut ats = Vec::with_capacity(((end - self.init_cursor) * per) as usize);
-        for i in self.init_cursor..end {
+        };
+        let mut ats = Vec::with_capacity((pixels.end - pixels.start) as usize * indices.len());
+        for i in pixels {
             let p = self.space.pixel(i);
-            for k in 0..self.init_spp {
+            for k in indices.clone() {
                 let key = pixel_key(p, self.seed, SALT);
                 // The stream's own indices, so that two streams draw different points.
                 let k = self.stream.index(k);
                 let mut rng = Pcg32::new(super::mix64(key ^ u64::from(k)), u64::from(k));
                 let mut at = [0.0; MAX_DIMS];
-                at[0] = p[0] as f32 + rng.next_f32();
-                at[1] = p[1] as f32 + rng.next_f32();
+                // Inside the pixel: p + u rounds up to p + 1 for u near 1, a point of the next.
+                at[0] = in_pixel(p[0], rng.next_f32());
+                at[1] = in_pixel(p[1], rng.next_f32());
                 for a in at.iter_mut().take(self.dims).skip(2) {
                     *a = rng.next_f32();
                 }
                 ats.push(at);
             }
         }
-        self.init_cursor = end;
         self.queue(ats);
         true
     }
@@ -457,15 +476,26 @@ impl Sampler for MdasSampler {
                 }
             }
         }
-        if !self.built && self.init_observed >= self.space.pixels() * u64::from(self.init_spp) {
-            self.built = true;
-            self.split_if_full(0);
+        // The first round's worth of points (its count, which a time plan may have shortened,
+        // per pixel; a pilot's, for the stream it leads), seen, is split at once.
+        if !self.built && self.init_observed >= self.first_round() {
+            self.build_tree();
         }
     }
 
     fn halt(&mut self) {
-        // The first round covers every pixel; no adaptive round starts after this.
+        // The first round ends at the pass under way; no adaptive round starts after this.
         self.halted = true;
+        self.first.halt();
+    }
+
+    fn plan_for(&mut self, spp: u32) -> bool {
+        self.plan_spp = spp.clamp(1, self.spp);
+        // The first round, while under way, shrinks to its share (not inside a pass).
+        if !self.init_given {
+            self.first.shorten((self.plan_spp / 4).max(1));
+        }
+        true
     }
 
     fn report(&self) -> SamplerReport {
@@ -548,7 +578,9 @@ fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
         space,
         dims,
         spp,
-        init_spp,
+        plan_spp: spp,
+        first: PixelCursor::new(space, init_spp),
+        init_given: p.get("initspp").is_some(),
         seed: setup.seed,
         stream: setup.stream,
         leaf_samples: int_in(p, "leafsamples", 8, 2..=1024)? as usize,
@@ -568,12 +600,11 @@ fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
         samples: Vec::new(),
         pending: Vec::new(),
         pending_at: 0,
-        init_cursor: 0,
         given: 0,
         per_pixel: vec![0; space.pixels() as usize],
+        init_observed: 0,
         rounds: 1,
         halted: false,
-        init_observed: 0,
         built: false,
     };
     Ok(Box::new(sampler))

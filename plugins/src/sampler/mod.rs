@@ -91,6 +91,16 @@ pub trait Sampler: Send {
         false
     }
 
+    /// Plans for `spp` samples per pixel in all, at most its own budget: a time limit's
+    /// estimate of what fits in the time left, made again after every batch
+    /// (`--time-limit`, issue 26, item 4), so that an adaptive sampler reaches its adaptive
+    /// stage in the time rather than spending it on a first stage planned for its budget.
+    /// Says whether it plans by it; by default it does not, and the time limit just stops it.
+    fn plan_for(&mut self, spp: u32) -> bool {
+        let _ = spp;
+        false
+    }
+
     /// Whether the next batch may be asked for before the last one is observed (so that it is
     /// planned while that one is traced); the order of calls is the same whatever the timing.
     fn plans_ahead(&self) -> bool {
@@ -344,6 +354,24 @@ impl PixelCursor {
             };
         }
         Some(batch)
+    }
+
+    /// The fewest samples per pixel the walk can still end at: the passes given and the one
+    /// under way (at least 1).
+    pub(crate) fn floor(&self) -> u32 {
+        let under_way = if self.next_pixel > 0 {
+            self.pass_len.min(self.spp - self.pass_start)
+        } else {
+            0
+        };
+        (self.pass_start + under_way).clamp(1, self.spp.max(1))
+    }
+
+    /// Lowers the walk's samples per pixel to `spp`, but not below [`Self::floor`] (so that
+    /// every pixel still ends with as many samples); returns the count in force.
+    pub(crate) fn shorten(&mut self, spp: u32) -> u32 {
+        self.spp = spp.clamp(self.floor(), self.spp.max(1));
+        self.spp
     }
 
     /// Ends the walk after the current pass (after the first pass, if none is complete yet).

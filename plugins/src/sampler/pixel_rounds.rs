@@ -5,7 +5,7 @@
 // Channel and dim loops index several small arrays at once, as the formulas do.
 #![allow(clippy::needless_range_loop)]
 
-use super::{pixel_key, IndexStream, Sampler, SamplerSetup, BATCH_SAMPLES};
+use super::{pixel_key, IndexStream, PixelCursor, Sampler, SamplerSetup, BATCH_SAMPLES};
 use crate::film::{luminance, Film, Spectrum};
 use crate::registry::{int_in, ParamSpec};
 use crate::space::{RenderingSpace, SamplePoint};
@@ -90,7 +90,14 @@ pub(crate) struct PixelRounds<M> {
     salt: u64,
     /// Which interleaved stream of sample indices it gives.
     stream: IndexStream,
-    /// Samples each pixel gets in the round under way.
+    /// The first, uniform round's walk: pass by pass over every pixel, so that a time limit
+    /// ends it at a pass and [`Sampler::plan_for`] can shorten it.
+    first: PixelCursor,
+    /// Whether `initspp` was given (then a time plan keeps it).
+    init_given: bool,
+    /// Adaptive rounds after the first.
+    adaptive_rounds: u32,
+    /// Samples each pixel gets in the adaptive round under way.
     plan: Vec<u32>,
     /// The next pixel of the plan to emit.
     cursor: usize,
@@ -98,6 +105,8 @@ pub(crate) struct PixelRounds<M> {
     unplanned: u64,
     /// Samples of each adaptive round after the first.
     round_size: u64,
+    /// Adaptive samples planned so far.
+    adaptive_planned: u64,
     moments: PixelMoments,
     /// Sample indices given so far per pixel.
     given: Vec<u32>,
@@ -131,10 +140,14 @@ impl<M: PixelMethod> PixelRounds<M> {
             seed,
             salt,
             stream: IndexStream::ALL,
-            plan: vec![init; pixels],
+            first: PixelCursor::new(space, init),
+            init_given: false,
+            adaptive_rounds: rounds.max(1),
+            plan: Vec::new(),
             cursor: 0,
             unplanned: rest,
             round_size: rest.div_ceil(u64::from(rounds.max(1))),
+            adaptive_planned: 0,
             moments: PixelMoments::new(pixels),
             given: vec![0; pixels],
             rounds: 1,
@@ -210,6 +223,12 @@ impl<M: PixelMethod> PixelRounds<M> {
         plan
     }
 
+    /// The same sampler, keeping its first round's count under a time plan when it was given.
+    pub(crate) fn init_given(mut self, given: bool) -> Self {
+        self.init_given = given;
+        self
+    }
+
     /// The same sampler giving stream `stream`'s sample indices.
     pub(crate) fn with_stream(mut self, stream: IndexStream) -> Self {
         self.stream = stream;
@@ -231,6 +250,7 @@ impl<M: PixelMethod> PixelRounds<M> {
         };
         self.cursor = 0;
         self.unplanned -= n;
+        self.adaptive_planned += n;
         self.rounds += 1;
         true
     }
@@ -286,6 +306,7 @@ pub(crate) fn build<M: PixelMethod + 'static>(
     let unbiased = params.bool_or("unbiased", false)?;
     Ok(Box::new(
         PixelRounds::new(method, setup.space, spp, init, rounds, setup.seed, salt)
+            .init_given(params.get("initspp").is_some())
             .with_stream(setup.stream)
             .unbiased(unbiased),
     ))
@@ -340,6 +361,16 @@ impl<M: PixelMethod> Sampler for PixelRounds<M> {
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
         out.clear();
+        if let Some((pixels, indices)) = self.first.next() {
+            for i in pixels {
+                let i = i as usize;
+                for k in indices.clone() {
+                    out.push(self.point(i, self.stream.index(k)));
+                }
+                self.given[i] = indices.end;
+            }
+            return true;
+        }
         if self.cursor >= self.plan.len() && !self.plan_round() {
             return false;
         }
@@ -376,8 +407,31 @@ impl<M: PixelMethod> Sampler for PixelRounds<M> {
     }
 
     fn halt(&mut self) {
-        // The first round is every pixel's share; after it, no more rounds.
+        // The first round ends at the pass under way; after it, no more rounds.
         self.halted = true;
+        self.first.halt();
+    }
+
+    fn plan_for(&mut self, spp: u32) -> bool {
+        let spp = spp.clamp(1, self.spp);
+        // The first round, while under way, shrinks to its share (not inside a pass).
+        if !self.init_given {
+            self.first.shorten((spp / 4).max(2).min(spp));
+        }
+        let adaptive = self.space.pixels() * u64::from(spp.saturating_sub(self.first.spp()));
+        // Unbiased, the one adaptive round reads the first round alone: none after it.
+        let one_round_done = self.unbiased && self.rounds > 1;
+        self.unplanned = if one_round_done {
+            0
+        } else {
+            adaptive.saturating_sub(self.adaptive_planned)
+        };
+        self.round_size = if self.unbiased {
+            self.unplanned
+        } else {
+            adaptive.div_ceil(u64::from(self.adaptive_rounds))
+        };
+        true
     }
 
     fn report(&self) -> super::SamplerReport {

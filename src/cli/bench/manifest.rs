@@ -1,5 +1,6 @@
 //! The bench manifest (TOML): scenes, methods, budgets and references, read and checked.
 
+use crate::cli::render::TimePlan;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -65,6 +66,10 @@ pub struct Budgets {
     /// render time at each budget.
     #[serde(default = "yes")]
     pub equal_time: bool,
+    /// Equal-time runs take this `--spp` (a cap: an adaptive sampler plans for what fits in
+    /// the time, `--time-plan fit`) instead of what the method's own equal-spp run says fits.
+    #[serde(default)]
+    pub time_limited_spp: Option<u32>,
 }
 
 fn yes() -> bool {
@@ -143,6 +148,7 @@ impl Reference {
                 filter: filter.clone(),
                 integrator: integrator.clone(),
                 set: set.clone(),
+                time_plan: None,
             })),
         }
     }
@@ -166,6 +172,9 @@ pub struct Method {
     /// `--set KIND.PARAM=VALUE` settings.
     #[serde(default)]
     pub set: Vec<String>,
+    /// `--time-plan` of its time-limited runs (default: `acr render`'s, `fit`).
+    #[serde(default)]
+    pub time_plan: Option<TimePlan>,
 }
 
 /// How a run was budgeted.
@@ -208,6 +217,15 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
     {
         return Err(format!(
             "{}: budget {bad} spp is out of range",
+            path.display()
+        ));
+    }
+    if m.budgets
+        .time_limited_spp
+        .is_some_and(|s| s == 0 || s > crate::render::MAX_SPP)
+    {
+        return Err(format!(
+            "{}: time_limited_spp is out of range",
             path.display()
         ));
     }

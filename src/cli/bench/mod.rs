@@ -210,6 +210,10 @@ fn run_render(
     }
     if let Some(t) = time_limit {
         cmd.arg("--time-limit").arg(format!("{t:.6}"));
+        if let Some(plan) = method.time_plan {
+            let name = clap::ValueEnum::to_possible_value(&plan).expect("named");
+            cmd.arg("--time-plan").arg(name.get_name());
+        }
     }
     if sampler_cost {
         cmd.arg("--sampler-cost");
@@ -339,7 +343,9 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
                             let (run_spp, limit) = match mode {
                                 Mode::EqualSpp => (spp, None),
                                 Mode::EqualTime => (
-                                    equal_time_spp(spp, baseline_seconds, own_seconds),
+                                    m.budgets.time_limited_spp.unwrap_or_else(|| {
+                                        equal_time_spp(spp, baseline_seconds, own_seconds)
+                                    }),
                                     baseline_seconds,
                                 ),
                             };

@@ -28,13 +28,17 @@ impl ClusterSampler {
     /// The samples its rounds are to give: what the first stage leaves of the budget of the
     /// pixels it places (those of its colour, in an unbiased pair).
     pub(super) fn adaptive_budget(&self) -> u64 {
+        self.own_pixels() * u64::from(self.settings.spp - self.settings.init_spp)
+    }
+
+    /// The pixels whose adaptive samples it places: all, or those of its colour.
+    pub(super) fn own_pixels(&self) -> u64 {
         let pixels = self.space.pixels();
-        let own = match self.settings.colour {
+        match self.settings.colour {
             None => pixels,
             Some(0) => pixels.div_ceil(2),
             Some(_) => pixels / 2,
-        };
-        own * u64::from(self.settings.spp - self.settings.init_spp)
+        }
     }
 }
 
@@ -167,6 +171,15 @@ impl Sampler for Crossed {
         // which hold the other colour's first stage alone.
         for h in &mut self.halves {
             h.settle_at_noise(threshold, min_spp);
+        }
+        true
+    }
+
+    fn plan_for(&mut self, spp: u32) -> bool {
+        // Both halves' first stages end at the same pass: the later of the two's floors.
+        let floor = self.halves[0].init_floor().max(self.halves[1].init_floor());
+        for h in &mut self.halves {
+            h.plan_budget(spp, floor);
         }
         true
     }

@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 mod crossed;
 mod noise;
+mod plan;
 use crossed::own_colour;
 mod settings;
 #[cfg(test)]
@@ -92,6 +93,8 @@ pub struct ClusterSampler {
     pixel_count: Vec<u32>,
     /// Adaptive samples still to give.
     remaining: u64,
+    /// Adaptive samples given so far.
+    given_adaptive: u64,
     queue: BucketQueue,
     version: Vec<u32>,
     /// The cell and in-cell offsets of each point of the round being planned (or of the
@@ -144,6 +147,7 @@ impl ClusterSampler {
                 .with_stream(settings.stream),
             // The whole image's until `for_colour` says otherwise.
             remaining: pixels * u64::from(settings.spp - settings.init_spp),
+            given_adaptive: 0,
             settings,
             seed,
             space,
@@ -340,6 +344,7 @@ impl ClusterSampler {
         let cells = std::mem::take(&mut self.round_cells);
         self.in_flight.push_back((cells, clusters));
         self.remaining -= planned_total;
+        self.given_adaptive += planned_total;
         self.rounds += 1;
     }
 
@@ -781,6 +786,12 @@ impl Sampler for ClusterSampler {
 
     fn stop_at_noise(&mut self, threshold: f64, min_spp: u32) -> bool {
         self.settle_at_noise(threshold, min_spp);
+        true
+    }
+
+    fn plan_for(&mut self, spp: u32) -> bool {
+        let floor = self.init_floor();
+        self.plan_budget(spp, floor);
         true
     }
 
