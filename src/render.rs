@@ -424,7 +424,10 @@ pub fn render_with(
             // From one sample per pixel on, the speed so far is a fair guess of the rest.
             if counts.samples >= pixels {
                 let spp = spp_in_time(counts.samples, pixels, start.elapsed(), limit);
-                if spp < sampler.spp() && sampler.plan_for(spp) {
+                // Once planned short, a later estimate may raise the plan again (to the cap).
+                if (spp < sampler.spp() || planned_short)
+                    && sampler.plan_for(spp.min(sampler.spp()))
+                {
                     planned_short = true;
                 }
             }

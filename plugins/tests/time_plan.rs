@@ -6,6 +6,7 @@
 mod common;
 
 use acr_parser::Values;
+use acr_plugins::sampler::drive_with;
 use acr_plugins::{Dims, RenderingSpace, SamplePoint, Sampler};
 use std::collections::HashMap;
 
@@ -49,41 +50,16 @@ fn cluster(unbiased: bool, spp: u32) -> Box<dyn Sampler> {
 /// Every point `s` gives, in the render loop's order of calls, with `plan_for(plan)` called
 /// after batch `after` (the render loop calls it after every batch; once is what matters).
 fn points_with_plan(s: &mut dyn Sampler, after: usize, plan: u32) -> Vec<SamplePoint> {
-    let (mut all, mut batch, mut next) = (Vec::new(), Vec::new(), Vec::new());
-    let mut pending: Option<(Vec<SamplePoint>, Vec<[f32; 3]>)> = None;
-    let mut batches = 0;
-    let mut more = s.next_batch(&mut batch);
-    while more {
-        let ahead = s.plans_ahead();
-        let r: Vec<[f32; 3]> = batch
-            .iter()
+    let radiance = |b: &[SamplePoint]| {
+        b.iter()
             .map(|q| common::noisy_step(q, 0.0, |_| false))
-            .collect();
-        if let Some((b, r)) = pending.take() {
-            s.observe(&b, &r);
-        }
-        let planned = ahead.then(|| s.next_batch(&mut next));
-        all.extend_from_slice(&batch);
-        batches += 1;
-
+            .collect()
+    };
+    drive_with(s, radiance, |s, batches| {
         if batches == after {
             assert!(s.plan_for(plan), "{} plans for the time", s.name());
         }
-        match planned {
-            Some(planned) => {
-                pending = Some((std::mem::replace(&mut batch, std::mem::take(&mut next)), r));
-                more = planned;
-            }
-            None => {
-                s.observe(&batch, &r);
-                more = s.next_batch(&mut batch);
-            }
-        }
-    }
-    if let Some((b, r)) = pending {
-        s.observe(&b, &r);
-    }
-    all
+    })
 }
 
 /// Each pixel's count, after checking that its indices run 0, 1, 2, ...

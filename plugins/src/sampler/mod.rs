@@ -469,8 +469,22 @@ impl<T: PixelPattern> Sampler for T {
 /// halting after `halt_after` batches if given; every point given, in order.
 pub fn drive(
     sampler: &mut dyn Sampler,
-    mut radiance: impl FnMut(&[SamplePoint]) -> Vec<[f32; 3]>,
+    radiance: impl FnMut(&[SamplePoint]) -> Vec<[f32; 3]>,
     halt_after: Option<usize>,
+) -> Vec<SamplePoint> {
+    drive_with(sampler, radiance, |s, batches| {
+        if halt_after == Some(batches) {
+            s.halt();
+        }
+    })
+}
+
+/// [`drive`], calling `after_batch` with the sampler and the count of batches given after each
+/// one, where the render loop halts or re-plans it.
+pub fn drive_with(
+    sampler: &mut dyn Sampler,
+    mut radiance: impl FnMut(&[SamplePoint]) -> Vec<[f32; 3]>,
+    mut after_batch: impl FnMut(&mut dyn Sampler, usize),
 ) -> Vec<SamplePoint> {
     let (mut all, mut batch, mut next) = (Vec::new(), Vec::new(), Vec::new());
     let mut pending: Option<(Vec<SamplePoint>, Vec<[f32; 3]>)> = None;
@@ -486,9 +500,7 @@ pub fn drive(
         let planned = ahead.then(|| sampler.next_batch(&mut next));
         all.extend_from_slice(&batch);
         batches += 1;
-        if halt_after == Some(batches) {
-            sampler.halt();
-        }
+        after_batch(&mut *sampler, batches);
         match planned {
             Some(planned) => {
                 pending = Some((std::mem::replace(&mut batch, std::mem::take(&mut next)), r));
