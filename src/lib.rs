@@ -39,8 +39,6 @@ pub mod transform;
 
 pub use acr_parser as parser;
 
-/// Luminance of linear RGB (pbrt's y(): Rec. 709 weights).
-#[inline]
-pub fn spectrum_luminance(c: geometry::Spectrum) -> f32 {
-    0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
-}
+/// Luminance of linear RGB (pbrt's y(): Rec. 709 weights), one definition for the core and
+/// the plugins.
+pub use acr_plugins::color::luminance as spectrum_luminance;

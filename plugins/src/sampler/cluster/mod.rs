@@ -11,7 +11,7 @@ use super::sobol::Scramble;
 use super::{mix64, Pcg32, PixelPattern, Sampler, SamplerReport, SobolSampler, BATCH_SAMPLES};
 use crate::cluster::build::initial_clustering;
 use crate::cluster::clusters::UNASSIGNED;
-use crate::cluster::features::{level, raw_gradient, raw_variance, Squashed};
+use crate::cluster::features::Squashed;
 use crate::cluster::grid::MAX_DIMS;
 use crate::cluster::queue::{BucketQueue, Queued};
 use crate::cluster::{CellGrid, CellSums, CellView, Clustering, FeatureScale};
@@ -22,7 +22,9 @@ use rayon::prelude::*;
 mod crossed;
 mod noise;
 mod plan;
+mod update;
 use crossed::own_colour;
+use update::{CellUpdate, Change};
 mod settings;
 #[cfg(test)]
 use settings::build;
@@ -41,33 +43,12 @@ const PICKS_PER_TASK: usize = 64;
 /// Smallest round, in samples: enough to keep every thread busy.
 const MIN_ROUND: u64 = 4096;
 
-/// Changed cells whose clusters are read ahead of their moves at a time (see
-/// [`Clustering::warm`]).
-const WARM_RUN: usize = 16;
-
 /// Where the sampler is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
     Init,
     Adaptive,
     Done,
-}
-
-/// A cell whose feature changed in an update, with what the serial moves need of it.
-#[derive(Clone, Copy, Debug)]
-struct Change {
-    cell: u32,
-    old: Squashed,
-    new: Squashed,
-    samples: u32,
-}
-
-/// What an update reads of a touched cell's own sums (an empty neighbour's: its level alone).
-#[derive(Clone, Copy, Debug)]
-struct CellUpdate {
-    level: f32,
-    variance: f32,
-    samples: u32,
 }
 
 /// A planned round's points' cells (and in-cell offsets) and the clusters it sampled.
@@ -492,135 +473,6 @@ impl ClusterSampler {
             self.round_cells[*r] = (cell, u);
             *r += 1;
         }
-    }
-
-    /// Table 1's UpdateCluster after a round: new levels and features for the cells that got
-    /// samples and their face neighbours, then the cells that no longer fit move.
-    fn update(&mut self, round_clusters: Vec<u32>) -> Vec<u32> {
-        // The cells that got samples get new features; their neighbours' levels follow where
-        // those are filled in from them (no samples of their own), but their features wait
-        // until they are sampled: recomputing them too (table 1) cost 5 to 11 times as much
-        // (one feature per face neighbour) for features that move by one cell's share.
-        let mut dirty = std::mem::take(&mut self.dirty);
-        dirty.clear();
-        for (w, bits) in self.touched.iter_mut().enumerate() {
-            while *bits != 0 {
-                dirty.push((w * 64) as u32 + bits.trailing_zeros());
-                *bits &= *bits - 1;
-            }
-        }
-        let (grid, sums) = (&self.grid, &self.sums);
-        let mut empty: Vec<u32> = Vec::new();
-        if self.empty_cells > 0 {
-            empty = dirty
-                .par_iter()
-                .flat_map_iter(|&c| {
-                    let mut nbrs = Vec::with_capacity(2 * MAX_DIMS);
-                    grid.neighbours(c as usize, &mut nbrs);
-                    nbrs.retain(|&j| sums.count[j] == 0);
-                    nbrs.into_iter().map(|j| j as u32)
-                })
-                .collect();
-            empty.par_sort_unstable();
-            empty.dedup();
-            self.empty_cells = sums.count.par_iter().filter(|&&n| n == 0).count();
-        }
-        // Levels, and what else the features read of a touched cell's own sums, in one pass:
-        // read again in the next pass, those sums had left the cache (a fifth of the features'
-        // time at 700x700, by `perf annotate`).
-        let mut updates = std::mem::take(&mut self.cell_updates);
-        dirty
-            .par_iter()
-            .chain(empty.par_iter())
-            .enumerate()
-            .map(|(k, &i)| {
-                let i = i as usize;
-                let touched = k < dirty.len();
-                CellUpdate {
-                    level: level(grid, sums, i),
-                    variance: if touched {
-                        raw_variance(grid, sums, i)
-                    } else {
-                        0.0
-                    },
-                    samples: sums.count[i],
-                }
-            })
-            .collect_into_vec(&mut updates);
-        for (&i, f) in dirty.iter().chain(&empty).zip(&updates) {
-            self.levels[i as usize] = f.level;
-        }
-        let mut nbrs = Vec::new();
-        let grid = &self.grid;
-        let levels = &self.levels;
-        let scale = self.scale.expect("clustered");
-        let n = grid.dims();
-        let squashed = &self.squashed;
-        // New raw features, and the old and new feature vectors of the cells whose features changed,
-        // made in parallel: the moves below are the only serial part.
-        let mut changes = std::mem::take(&mut self.changes);
-        changes.clear();
-        changes.par_extend(dirty.par_iter().zip(&updates).filter_map(|(&i, f)| {
-            let i = i as usize;
-            let g = raw_gradient(grid, levels, i);
-            let q = scale.squash(g, f.variance, f.level);
-            // What the serial moves below read of the cell, read here in parallel: at 1024x1024
-            // those reads missed the cache one after another.
-            (q != squashed[i]).then_some(Change {
-                cell: i as u32,
-                old: squashed[i],
-                new: q,
-                samples: f.samples,
-            })
-        }));
-        self.cell_updates = updates;
-        let clustering = self.clustering.as_mut().expect("clustered");
-        let mut changed: Vec<u32> = round_clusters;
-        for run in changes.chunks(WARM_RUN) {
-            clustering.warm(run.iter().map(|c| c.cell as usize));
-            for change in run {
-                let i = change.cell as usize;
-                let c = grid.coords(i);
-                let (old, new) = (
-                    scale.feature_of(n, &c, change.old),
-                    scale.feature_of(n, &c, change.new),
-                );
-                self.squashed[i] = change.new;
-                let samples = u64::from(change.samples);
-                let (a, b) = clustering.update(grid, i, &old, &new, samples, &mut nbrs);
-                changed.push(a);
-                changed.extend(b);
-            }
-        }
-        (self.dirty, self.changes) = (dirty, changes);
-        let live = clustering.live();
-        if self.version.len() < clustering.clusters.len() {
-            self.version.resize(clustering.clusters.len(), 0);
-        }
-        // Each changed cluster once, in the order of its first change: a bit per cluster
-        // rather than a sort (4% of the sampler's instructions, by callgrind).
-        let marks = &mut self.cluster_marks;
-        marks.resize(clustering.clusters.len().div_ceil(64), 0);
-        changed.retain(|&id| {
-            let (word, bit) = (id as usize / 64, 1u64 << (id % 64));
-            let first = marks[word] & bit == 0;
-            marks[word] |= bit;
-            first
-        });
-        for &id in &changed {
-            marks[id as usize / 64] &= !(1u64 << (id % 64));
-        }
-        for &id in &changed {
-            self.version[id as usize] = self.version[id as usize].wrapping_add(1);
-        }
-        if self.queue.len() > 2 * live + 1024 {
-            // Mostly stale entries: rebuild.
-            self.queue.clear();
-            changed.clear();
-            changed.extend(0..self.version.len() as u32);
-        }
-        self.push_all(changed.iter().copied());
-        changed
     }
 
     /// The final partition in image space: each pixel takes the cluster of most of the cells
