@@ -683,6 +683,26 @@ mod tests {
             let e = read_manifest(&p).unwrap_err();
             assert!(e.contains(message), "{e}");
         }
+        // The time-limited runs' spp and a method's time plan: read, and checked.
+        let with = |budgets: &str, method: &str| {
+            format!(
+                "[budgets]\nspp = [1]\n{budgets}\n[reference]\nsampler = \"sobol\"\nspp = 4\n\
+                 [[scene]]\nname = \"a\"\npath = \"a.pbrt\"\n[[method]]\nlabel = \"x\"\n{method}\n"
+            )
+        };
+        std::fs::write(&p, with("time_limited_spp = 64", "time_plan = \"budget\"")).unwrap();
+        let m = read_manifest(&p).unwrap();
+        assert_eq!(m.budgets.time_limited_spp, Some(64));
+        assert_eq!(
+            m.methods[0].time_plan,
+            Some(crate::cli::render::TimePlan::Budget)
+        );
+        std::fs::write(&p, with("time_limited_spp = 0", "")).unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("time_limited_spp is out of range"), "{e}");
+        std::fs::write(&p, with("", "time_plan = \"soon\"")).unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("m.toml:12:13:") && e.contains("fit"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 
