@@ -464,6 +464,27 @@ impl<T: PixelPattern> Sampler for T {
     }
 }
 
+/// The next of two samplers taking turns that gives a batch (`give` asks one): from `turn` on,
+/// skipping those marked `done` and marking those whose budget is spent; which one gave.
+pub(crate) fn alternate(
+    turn: &mut usize,
+    done: &mut [bool; 2],
+    mut give: impl FnMut(usize) -> bool,
+) -> Option<usize> {
+    for _ in 0..2 {
+        let h = *turn;
+        *turn = 1 - h;
+        if done[h] {
+            continue;
+        }
+        if give(h) {
+            return Some(h);
+        }
+        done[h] = true;
+    }
+    None
+}
+
 /// Runs `sampler` to the end in the render loop's order of calls (a sampler that plans ahead
 /// is asked for the next batch before it observes the last), with `radiance` of each batch,
 /// halting after `halt_after` batches if given; every point given, in order.

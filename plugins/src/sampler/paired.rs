@@ -13,7 +13,9 @@
 //!   image their mean. After the first adaptive round a stream's values still reach its own
 //!   later rounds through where the other stream's points went (measured in the README).
 
-use super::{pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, SamplerSetup};
+use super::{
+    alternate, pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, SamplerSetup,
+};
 use crate::cluster::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
@@ -209,19 +211,15 @@ impl Sampler for Paired {
             self.turn = 0;
         }
         // Otherwise batches alternate between the streams while both have some.
-        for _ in 0..2 {
-            let s = self.turn;
-            self.turn = 1 - s;
-            if self.done[s] {
-                continue;
-            }
-            if self.streams[s].next_batch(out) {
-                self.given.push_back(s);
-                return true;
-            }
-            self.done[s] = true;
-        }
-        false
+        let streams = &mut self.streams;
+        let given = alternate(&mut self.turn, &mut self.done, |s| {
+            streams[s].next_batch(out)
+        });
+        let Some(s) = given else {
+            return false;
+        };
+        self.given.push_back(s);
+        true
     }
 
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {

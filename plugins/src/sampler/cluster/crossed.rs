@@ -12,7 +12,7 @@
 use super::{ClusterSampler, Phase};
 use crate::cluster::CellView;
 use crate::partition::Partition;
-use crate::sampler::{Sampler, SamplerReport};
+use crate::sampler::{alternate, Sampler, SamplerReport};
 use crate::space::SamplePoint;
 use std::collections::VecDeque;
 
@@ -112,33 +112,29 @@ impl Sampler for Crossed {
         // The halves alternate batch by batch. Their first stages are alike (every pixel, in
         // the same passes), so each has handed over its last first-stage batch, and had the
         // other's observed, before it clusters.
-        for _ in 0..2 {
-            let h = self.turn;
-            self.turn = 1 - h;
-            if self.done[h] {
-                continue;
-            }
-            if self.halves[h].next_batch(out) {
-                // The call that ends the first stage clusters and plans the first round: the
-                // phase after the call tells which the batch is.
-                let first_stage = self.halves[h].phase == Phase::Init;
-                if first_stage {
-                    // Each half's first stage covers every pixel; it keeps its own colour's.
-                    let (x0, y0) = (self.halves[h].space.x0, self.halves[h].space.y0);
-                    let colour = h as u32;
-                    out.retain(|q| (q.pixel[0] - x0 + q.pixel[1] - y0) & 1 == colour);
-                }
-                self.given.push_back((h, first_stage));
-                self.last = Some(h);
-                if self.halt_after_next == Some(h) {
-                    self.halves[h].halt();
-                    self.halt_after_next = None;
-                }
-                return true;
-            }
-            self.done[h] = true;
+        let halves = &mut self.halves;
+        let given = alternate(&mut self.turn, &mut self.done, |h| {
+            halves[h].next_batch(out)
+        });
+        let Some(h) = given else {
+            return false;
+        };
+        // The call that ends the first stage clusters and plans the first round: the phase
+        // after the call tells which the batch is.
+        let first_stage = self.halves[h].phase == Phase::Init;
+        if first_stage {
+            // Each half's first stage covers every pixel; it keeps its own colour's.
+            let (x0, y0) = (self.halves[h].space.x0, self.halves[h].space.y0);
+            let colour = h as u32;
+            out.retain(|q| (q.pixel[0] - x0 + q.pixel[1] - y0) & 1 == colour);
         }
-        false
+        self.given.push_back((h, first_stage));
+        self.last = Some(h);
+        if self.halt_after_next == Some(h) {
+            self.halves[h].halt();
+            self.halt_after_next = None;
+        }
+        true
     }
 
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
