@@ -1,10 +1,10 @@
-//! The fit's albedo prefilter (`prefilter.rs`) on hand-made cells: it averages a noisy albedo
-//! with like neighbours, leaves a precise one alone, never crosses a depth, normal or shading
-//! edge, and stays finite on degenerate cells.
+//! The fit's feature prefilter (`prefilter.rs`) on hand-made cells: it averages a noisy
+//! albedo, depth or normal with like neighbours, leaves a precise one alone, never crosses a
+//! depth, normal or shading edge, and stays finite on degenerate cells.
 
 use acr_plugins::cluster::{CellGrid, CellSums};
 use acr_plugins::first_hit::Features;
-use acr_plugins::prefilter::prefilter_albedo;
+use acr_plugins::prefilter::prefilter_features;
 use acr_plugins::rng::mix64;
 use acr_plugins::space::{Dims, RenderingSpace, SamplePoint};
 
@@ -89,7 +89,7 @@ fn a_noisy_albedo_is_averaged_and_a_precise_one_kept() {
         };
         surface(a)
     });
-    let out = with(&sums, prefilter_albedo(&grid, &sums, 1, 1.0));
+    let out = with(&sums, prefilter_features(&grid, &sums, 1, 1.0));
     let index = |x: u32, y: u32| (y * W + x) as usize;
     let left: Vec<usize> = (1..H - 1)
         .flat_map(|y| (1..W / 2 - 1).map(move |x| index(x, y)))
@@ -106,9 +106,61 @@ fn a_noisy_albedo_is_averaged_and_a_precise_one_kept() {
             );
         }
     }
-    // Only the albedo changes: normals and depth are the input's.
+    // Normals and depth, the same exact values everywhere, stay as they were.
     for i in 0..grid.len() {
-        assert_eq!(out.features[i][3..], sums.features[i][3..]);
+        let (a, b) = (
+            out.mean_features(i).unwrap(),
+            sums.mean_features(i).unwrap(),
+        );
+        for k in 3..7 {
+            assert!((a[k] - b[k]).abs() < 1e-6, "cell {i} feature {k}");
+        }
+    }
+}
+
+/// The spread over `ids` of feature `k`'s cell means.
+fn spread_of(sums: &CellSums, ids: &[usize], k: usize) -> f64 {
+    let of = |i: usize| sums.mean_features(i).unwrap()[k];
+    let m = ids.iter().map(|&i| of(i)).sum::<f64>() / ids.len() as f64;
+    ids.iter().map(|&i| (of(i) - m).powi(2)).sum::<f64>() / ids.len() as f64
+}
+
+#[test]
+fn a_noisy_depth_and_normal_are_averaged_and_an_exact_step_kept() {
+    // Left half: a silhouette blurred by the lens, each sample meeting the foreground (depth
+    // 2, facing +z) or the background (depth 10, facing +x) at random, so a cell's mean depth
+    // and normal are noisy; right half: a step of whole pixels between depth 5 and 50, exact
+    // within each pixel.
+    let (grid, sums) = cells(|p, i| {
+        if p[0] < W / 2 {
+            if noise(p, i, 4) < 0.5 {
+                ([0.5; 3], [0.5, 0.5, 0.5, 0.0, 0.0, 1.0, 2.0])
+            } else {
+                ([0.5; 3], [0.5, 0.5, 0.5, 1.0, 0.0, 0.0, 10.0])
+            }
+        } else {
+            let depth = if p[1] % 2 == 0 { 5.0 } else { 50.0 };
+            ([0.5; 3], [0.5, 0.5, 0.5, 0.0, 0.0, 1.0, depth])
+        }
+    });
+    let out = with(&sums, prefilter_features(&grid, &sums, 1, 2.0));
+    let index = |x: u32, y: u32| (y * W + x) as usize;
+    let left: Vec<usize> = (1..H - 1)
+        .flat_map(|y| (1..W / 2 - 1).map(move |x| index(x, y)))
+        .collect();
+    for (k, name) in [(6, "depth"), (3, "normal x"), (5, "normal z")] {
+        let (before, after) = (spread_of(&sums, &left, k), spread_of(&out, &left, k));
+        assert!(after < 0.5 * before, "{name}: spread {before} -> {after}");
+    }
+    for y in 0..H {
+        for x in W / 2 + 1..W {
+            let i = index(x, y);
+            let (a, b) = (
+                out.mean_features(i).unwrap()[6],
+                sums.mean_features(i).unwrap()[6],
+            );
+            assert!((a - b).abs() < 1e-3 * b, "pixel {x}, {y}: depth {b} -> {a}");
+        }
     }
 }
 
@@ -136,7 +188,7 @@ fn depth_normal_and_shading_edges_are_not_crossed() {
                     right(level + 0.2 * n)
                 }
             });
-            let out = with(&sums, prefilter_albedo(&grid, &sums, 1, 4.0));
+            let out = with(&sums, prefilter_features(&grid, &sums, 1, 4.0));
             (0..H)
                 .flat_map(|y| (0..W / 2).map(move |x| (y * W + x) as usize))
                 .map(|i| mean_albedo(&out, i))
@@ -163,7 +215,7 @@ fn degenerate_cells_stay_finite_and_unfiltered_sums_pass_through() {
         let a = if p[0] % 3 == 0 { 0.0 } else { 0.5 };
         ([0.0; 3], [a, a, a, 0.0, 0.0, 1.0, 0.0])
     });
-    let out = with(&sums, prefilter_albedo(&grid, &sums, 2, 1.0));
+    let out = with(&sums, prefilter_features(&grid, &sums, 2, 1.0));
     for i in 0..grid.len() {
         assert_eq!(out.count[i], 1);
         let f = out.mean_features(i).unwrap();
@@ -172,7 +224,7 @@ fn degenerate_cells_stay_finite_and_unfiltered_sums_pass_through() {
     }
     // A radius of 0, or sums without features: the input.
     let (grid, sums) = cells(|p, i| surface(noise(p, i, 3)));
-    assert_eq!(prefilter_albedo(&grid, &sums, 0, 1.0), sums.features);
+    assert_eq!(prefilter_features(&grid, &sums, 0, 1.0), sums.features);
     let plain = CellSums::new(&grid);
-    assert!(prefilter_albedo(&grid, &plain, 1, 1.0).is_empty());
+    assert!(prefilter_features(&grid, &plain, 1, 1.0).is_empty());
 }

@@ -382,7 +382,7 @@ struct Band<'a> {
     offset: &'a mut [f32],
     offset_sq: &'a mut [f32],
     features: &'a mut [Features],
-    albedo_sq: &'a mut [[f32; 3]],
+    features_sq: &'a mut [Features],
     dims: usize,
 }
 
@@ -396,7 +396,7 @@ impl Band<'_> {
             for (s, v) in sum.iter_mut().zip(f) {
                 *s += v;
             }
-            for (s, v) in self.albedo_sq[i].iter_mut().zip(f) {
+            for (s, v) in self.features_sq[i].iter_mut().zip(f) {
                 *s += v * v;
             }
         }
@@ -443,9 +443,9 @@ pub struct CellSums {
     pub offset_sq: Vec<f32>,
     /// Sum of the samples' first-hit features; empty unless made [`CellSums::with_features`].
     pub features: Vec<Features>,
-    /// Sum of the squares of the samples' first-hit albedo, beside `features`: the albedo's
-    /// own noise, for the fit's feature prefilter.
-    pub albedo_sq: Vec<[f32; 3]>,
+    /// Sum of the squares of the samples' first-hit features, beside `features`: each
+    /// feature's own noise, for the fit's feature prefilter.
+    pub features_sq: Vec<Features>,
     dims: usize,
 }
 
@@ -477,7 +477,7 @@ impl CellSums {
             offset: Vec::new(),
             offset_sq: Vec::new(),
             features: Vec::new(),
-            albedo_sq: Vec::new(),
+            features_sq: Vec::new(),
             dims: grid.dims(),
         }
     }
@@ -485,7 +485,7 @@ impl CellSums {
     /// These sums, also keeping each cell's sum of first-hit features.
     pub fn with_features(mut self) -> Self {
         self.features = vec![[0.0; crate::first_hit::FEATURES]; self.count.len()];
-        self.albedo_sq = vec![[0.0; 3]; self.count.len()];
+        self.features_sq = vec![[0.0; crate::first_hit::FEATURES]; self.count.len()];
         self
     }
 
@@ -589,7 +589,7 @@ impl CellSums {
             offset: &mut self.offset[o.clone()],
             offset_sq: &mut self.offset_sq[o],
             features: &mut self.features[f.clone()],
-            albedo_sq: &mut self.albedo_sq[f],
+            features_sq: &mut self.features_sq[f],
             dims: d,
         }
     }
@@ -611,11 +611,11 @@ impl CellSums {
             .zip(chunks(&mut self.offset, band_len * d))
             .zip(chunks(&mut self.offset_sq, band_len * d))
             .zip(chunks(&mut self.features, band_len))
-            .zip(chunks(&mut self.albedo_sq, band_len))
+            .zip(chunks(&mut self.features_sq, band_len))
             .map(
                 |(
                     (((((((count, rgb), rgb_sq), lum), lum_sq), offset), offset_sq), features),
-                    albedo_sq,
+                    features_sq,
                 )| Band {
                     count,
                     rgb,
@@ -625,7 +625,7 @@ impl CellSums {
                     offset,
                     offset_sq,
                     features,
-                    albedo_sq,
+                    features_sq,
                     dims: d,
                 },
             )
@@ -659,7 +659,7 @@ impl CellSums {
             + self.offset.capacity() * 4
             + self.offset_sq.capacity() * 4
             + self.features.capacity() * std::mem::size_of::<Features>()
-            + self.albedo_sq.capacity() * std::mem::size_of::<[f32; 3]>()
+            + self.features_sq.capacity() * std::mem::size_of::<Features>()
     }
 
     /// Active dims (offsets per cell).

@@ -19,7 +19,7 @@ use crate::cluster::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
 use crate::first_hit::Features;
 use crate::partition::Partition;
-use crate::prefilter::prefilter_albedo;
+use crate::prefilter::prefilter_features;
 use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
 use crate::sampler::ClusterSettings;
@@ -53,7 +53,7 @@ pub struct PolynomialFilter {
     features: Option<f64>,
     /// How a cell weighs in its cluster's fit.
     weights: CellWeights,
-    /// The albedo prefilter's radius in cells (0: off) and its kappa ([`prefilter_albedo`]).
+    /// The feature prefilter's radius in cells (0: off) and its kappa ([`prefilter_features`]).
     prefilter: (u32, f64),
 }
 
@@ -69,18 +69,28 @@ pub enum CellWeights {
 /// Standard errors of the noise test when features are on and `noise` is not set.
 pub const FEATURE_NOISE_Z: f64 = 8.0;
 
-/// The features' tolerance when features are on and `featuretolerance` is not set.
-pub const FEATURE_TOLERANCE: f64 = 0.1;
+/// The features' tolerance when features are on and `featuretolerance` is not set: with every
+/// feature prefiltered, 0.2 measured below 0.1 and 0.3 on defocus at 8 spp (README).
+pub const FEATURE_TOLERANCE: f64 = 0.2;
 
-/// The albedo prefilter's radius in cells, by default. Measured (README, seeds 1-3, 8 spp,
+/// The feature prefilter's radius in cells, by default. Measured (README, seeds 1-3, 8 spp,
 /// cluster+polynomial over stratified+gaussian): radius 1 took depth-of-field from 0.54 to 0.45
 /// and motion-dof from 0.71 to 0.57 with motion blur and the Cornell box unchanged; radius 2
 /// lost a little of that.
 pub const PREFILTER_RADIUS: u32 = 1;
 
-/// The albedo prefilter's NL-means strength, by default: 1 left motion blur unchanged, where
-/// 2 cost it 10% for 3% more on defocus.
-pub const PREFILTER_KAPPA: f64 = 1.0;
+/// The feature prefilter's NL-means strength, by default: with every feature prefiltered, 2
+/// measured below 1 and 3 on motion-dof at 8 spp and within 3% on defocus (README).
+pub const PREFILTER_KAPPA: f64 = 2.0;
+
+/// `significance` by default with features on: 0 (off). Keeping departures measured worse on
+/// every bench scene with features (the room 4.7x the MSE at 8 spp, and 0.8% dark at 2 spp);
+/// the features and the noise clusters already keep the edges it was for.
+pub const FEATURE_SIGNIFICANCE: f64 = 0.0;
+
+/// `significance` by default with features off (the paper's fit): 3, for the step edge of
+/// `tests/polynomial.rs`.
+pub const PLAIN_SIGNIFICANCE: f64 = 3.0;
 
 impl PolynomialFilter {
     /// The filter with its knobs.
@@ -101,7 +111,7 @@ impl PolynomialFilter {
         }
     }
 
-    /// With features: prefilters the cells' albedo within `radius` cells (0: off) with
+    /// With features: prefilters the cells' features within `radius` cells (0: off) with
     /// NL-means strength `kappa` before the clustering and the fit.
     pub fn with_prefilter(mut self, radius: u32, kappa: f64) -> Self {
         self.prefilter = (radius, kappa);
@@ -144,11 +154,11 @@ impl PolynomialFilter {
         let grid = view.grid;
         let (radius, kappa) = self.prefilter;
         let sums = view.sums;
-        // The features the clusters and the fit read: the albedo's noise averaged out across
+        // The features the clusters and the fit read: their noise averaged out across
         // neighbours.
         let filtered;
         let cell_features = if radius > 0 && self.features.is_some() {
-            filtered = prefilter_albedo(grid, sums, radius, kappa);
+            filtered = prefilter_features(grid, sums, radius, kappa);
             &filtered
         } else {
             &sums.features
@@ -510,7 +520,7 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
             ParamSpec::new(
                 "significance",
                 ParamType::Float,
-                "3",
+                "0 with features, 3 without",
                 "a cell whose mean departs from its cluster's model by more standard errors \
                  than this keeps the departure (0: never)",
             ),
@@ -544,7 +554,7 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
             ParamSpec::new(
                 "featuretolerance",
                 ParamType::Float,
-                "0.1",
+                "0.2",
                 "with features: the most two clusters' mean features may differ to merge \
                  (albedo per channel, half the normal per axis, depth relative)",
             ),
@@ -552,16 +562,17 @@ pub(super) const ENTRY: Entry<FilterBuild> = Entry {
                 "prefilter",
                 ParamType::Integer,
                 "1",
-                "with features: average each cell's albedo with the cells within this many \
-                 cells whose depth, normal and shading agree and whose albedo differs by no \
+                "with features: average each cell's features with the cells within this many \
+                 cells whose shading agrees and whose albedo, normal and depth differ by no \
                  more than their noise, before the fit (0: off)",
             ),
             ParamSpec::new(
                 "kappa",
                 ParamType::Float,
-                "1",
-                "the prefilter's strength: a neighbour whose albedo differs by d (squared) \
-                 weighs exp(-max(0, d - v) / (kappa^2 v)), v the two albedos' noise",
+                "2",
+                "the prefilter's strength: a neighbour whose feature differs by d (squared) \
+                 weighs exp(-max(0, d - v) / (kappa^2 v + s^2)), v the two cells' noise, s 0 \
+                 for albedo, 0.5 for the normal, 0.1 of the depth",
             ),
             ParamSpec::new(
                 "weights",
@@ -589,11 +600,17 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     };
     let ridge = float_in(p, "ridge", 1e-6, 0.0..=1.0)?;
     let clamp = p.bool_or("clamp", true)?;
-    let significance = float_in(p, "significance", 3.0, 0.0..=1e3)?;
+    let with_features = p.bool_or("features", true)?;
+    let significance = if with_features {
+        FEATURE_SIGNIFICANCE
+    } else {
+        PLAIN_SIGNIFICANCE
+    };
+    let significance = float_in(p, "significance", significance, 0.0..=1e3)?;
     let mut f = PolynomialFilter::new(degree, ridge, clamp, significance)
         .with_noise_clusters(float_in(p, "noise", 0.0, 0.0..=1e3)?);
     let tolerance = float_in(p, "featuretolerance", FEATURE_TOLERANCE, 0.0..=1e3)?;
-    if p.bool_or("features", true)? {
+    if with_features {
         f = f.with_features(Some(tolerance));
     }
     let radius = int_in(p, "prefilter", PREFILTER_RADIUS as i32, 0..=8)?;
