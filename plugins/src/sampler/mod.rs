@@ -407,6 +407,47 @@ pub(crate) trait PixelPattern: Send + Sync {
     const PROGRESSIVE: bool;
 }
 
+/// The next batch of `pattern`'s walk, with points made only for the pixels `keep` accepts
+/// (the others' are skipped, not made and dropped): what [`Sampler::next_batch`] gives, less
+/// the pixels left out. False once the walk is over.
+pub(crate) fn next_batch_where<T: PixelPattern>(
+    pattern: &mut T,
+    out: &mut Vec<SamplePoint>,
+    keep: impl Fn([u32; 2]) -> bool + Sync,
+) -> bool {
+    out.clear();
+    let Some((pixels, indices)) = pattern.cursor_mut().next() else {
+        return false;
+    };
+    let space = *pattern.cursor().space();
+    let kept: Vec<[u32; 2]> = (pixels.start..pixels.end)
+        .map(|i| space.pixel(i))
+        .filter(|&p| keep(p))
+        .collect();
+    make_points(&*pattern, &kept, indices, out);
+    true
+}
+
+/// The points with sample indices `indices` of each of `pixels`, in order, made in parallel.
+fn make_points<T: PixelPattern>(
+    pattern: &T,
+    pixels: &[[u32; 2]],
+    indices: Range<u32>,
+    out: &mut Vec<SamplePoint>,
+) {
+    let per_pixel = indices.len();
+    out.resize(pixels.len() * per_pixel, SamplePoint::UNMADE);
+    out.par_chunks_mut(PIXELS_PER_TASK * per_pixel)
+        .zip(pixels.par_chunks(PIXELS_PER_TASK))
+        .for_each_init(Vec::new, |points, (chunk, pixels)| {
+            for (slot, &p) in chunk.chunks_mut(per_pixel).zip(pixels) {
+                points.clear();
+                pattern.pixel(p, indices.clone(), points);
+                slot.copy_from_slice(points);
+            }
+        });
+}
+
 impl<T: PixelPattern> Sampler for T {
     fn name(&self) -> &'static str {
         T::NAME
@@ -417,29 +458,7 @@ impl<T: PixelPattern> Sampler for T {
     }
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        out.clear();
-        let Some((pixels, indices)) = self.cursor_mut().next() else {
-            return false;
-        };
-        let space = *self.cursor().space();
-        // Pixels' points are independent: made in parallel, each pixel's into its place.
-        let this = &*self;
-        let per_pixel = indices.len();
-        out.resize(
-            (pixels.end - pixels.start) as usize * per_pixel,
-            SamplePoint::UNMADE,
-        );
-        out.par_chunks_mut(PIXELS_PER_TASK * per_pixel)
-            .enumerate()
-            .for_each_init(Vec::new, |points, (task, chunk)| {
-                let first = pixels.start + (task * PIXELS_PER_TASK) as u64;
-                for (k, slot) in chunk.chunks_mut(per_pixel).enumerate() {
-                    points.clear();
-                    this.pixel(space.pixel(first + k as u64), indices.clone(), points);
-                    slot.copy_from_slice(points);
-                }
-            });
-        true
+        next_batch_where(self, out, |_| true)
     }
 
     fn halt(&mut self) {

@@ -121,13 +121,8 @@ impl Sampler for Crossed {
         };
         // The call that ends the first stage clusters and plans the first round: the phase
         // after the call tells which the batch is.
+        // (Each half's first stage makes its own colour's pixels' points only.)
         let first_stage = self.halves[h].phase == Phase::Init;
-        if first_stage {
-            // Each half's first stage covers every pixel; it keeps its own colour's.
-            let (x0, y0) = (self.halves[h].space.x0, self.halves[h].space.y0);
-            let colour = h as u32;
-            out.retain(|q| (q.pixel[0] - x0 + q.pixel[1] - y0) & 1 == colour);
-        }
         self.given.push_back((h, first_stage));
         self.last = Some(h);
         if self.halt_after_next == Some(h) {

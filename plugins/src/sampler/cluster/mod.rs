@@ -8,7 +8,10 @@
 //! and the image do not depend on the thread count.
 
 use super::sobol::Scramble;
-use super::{mix64, Pcg32, PixelPattern, Sampler, SamplerReport, SobolSampler, BATCH_SAMPLES};
+use super::{
+    mix64, next_batch_where, Pcg32, PixelPattern, Sampler, SamplerReport, SobolSampler,
+    BATCH_SAMPLES,
+};
 use crate::cluster::build::initial_clustering;
 use crate::cluster::clusters::UNASSIGNED;
 use crate::cluster::features::Squashed;
@@ -543,7 +546,16 @@ impl Sampler for ClusterSampler {
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
         out.clear();
         if self.phase == Phase::Init {
-            if self.init.next_batch(out) {
+            // Half of an unbiased pair: the first stage of its own colour's pixels only (the
+            // other half makes the other's).
+            let (x0, y0) = (self.space.x0, self.space.y0);
+            let given = match self.settings.colour {
+                Some(c) => {
+                    next_batch_where(&mut self.init, out, |p| (p[0] - x0 + p[1] - y0) & 1 == c)
+                }
+                None => self.init.next_batch(out),
+            };
+            if given {
                 for q in out.iter() {
                     let p = self.space.index_of(q.pixel);
                     self.pixel_count[p] += 1;
