@@ -1,6 +1,7 @@
 //! The feature vector F = (g, s, p) of a cell (ALGORITHM.md section 3, paper eq. 2-9).
 
-use super::grid::{CellGrid, CellSums, Coords, MAX_DIMS};
+use super::grid::{CellGrid, Coords, MAX_DIMS};
+use super::sums::CellSums;
 use rayon::prelude::*;
 
 /// Length of a feature vector: g, s, the level and one position per active dim.

@@ -8,10 +8,12 @@ pub mod clusters;
 pub mod features;
 pub mod grid;
 pub mod queue;
+pub mod sums;
 
 pub use clusters::{Cluster, Clustering, Membership, Moments};
 pub use features::{Feature, FeatureScale};
-pub use grid::{CellGrid, CellSums};
+pub use grid::CellGrid;
+pub use sums::CellSums;
 
 /// A grid's cells, their sums and, when a sampler made them, their clusters: what the
 /// polynomial reconstruction reads.
