@@ -369,11 +369,12 @@ impl CellGrid {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::space::Dims;
 
-    fn space(w: u32, h: u32, time: bool, lens: bool) -> RenderingSpace {
+    /// A space of `w` x `h` pixels from (10, 20), with time and lens dims as asked.
+    pub(crate) fn space(w: u32, h: u32, time: bool, lens: bool) -> RenderingSpace {
         RenderingSpace {
             x0: 10,
             x1: 10 + w,

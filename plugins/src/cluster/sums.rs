@@ -309,17 +309,7 @@ impl CellSums {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::space::{Dims, RenderingSpace};
-
-    fn space(w: u32, h: u32, time: bool, lens: bool) -> RenderingSpace {
-        RenderingSpace {
-            x0: 10,
-            x1: 10 + w,
-            y0: 20,
-            y1: 20 + h,
-            dims: Dims { time, lens },
-        }
-    }
+    use crate::cluster::grid::tests::space;
 
     #[test]
     fn luminance_only_sums_agree_with_full_ones() {
