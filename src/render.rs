@@ -475,6 +475,7 @@ fn spp_in_time(samples: u64, pixels: u64, elapsed: Duration, limit: Duration) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+    use acr_plugins::PixelStats;
 
     #[test]
     fn the_samples_that_fit_follow_the_speed_so_far() {
@@ -485,7 +486,6 @@ mod tests {
         assert_eq!(spp_in_time(1000, 100, s(4.0), s(3.0)), 10);
         assert_eq!(spp_in_time(0, 100, s(0.0), s(3.0)), 0);
     }
-    use acr_plugins::PixelStats;
 
     #[test]
     fn relative_error_is_the_mean_standard_error_over_the_mean() {

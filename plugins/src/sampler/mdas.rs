@@ -493,7 +493,7 @@ impl Sampler for MdasSampler {
         self.plan_spp = spp.clamp(1, self.spp);
         // The first round, while under way, shrinks to its share (not inside a pass).
         if !self.init_given {
-            self.first.shorten((self.plan_spp / 4).max(1));
+            self.first.shorten(super::first_stage_spp(self.plan_spp, 1));
         }
         true
     }
@@ -565,7 +565,8 @@ impl Sampler for MdasSampler {
 fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>> {
     let p = &c.params;
     let spp = super::pixel_samples(p, setup)?;
-    let init_spp = int_in(p, "initspp", (spp / 4).max(1) as i32, 1..=i64::from(spp))?;
+    let init_spp = super::first_stage_spp(spp, 1) as i32;
+    let init_spp = int_in(p, "initspp", init_spp, 1..=i64::from(spp))?;
     let space = setup.space;
     let dims = space.dims.count();
     let mut lo = [0.0; MAX_DIMS];

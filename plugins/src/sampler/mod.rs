@@ -36,6 +36,13 @@ pub const BATCH_SAMPLES: u64 = 1 << 15;
 /// Largest accepted samples per pixel.
 pub const MAX_SPP: u32 = 1 << 20;
 
+/// An adaptive sampler's first, uniform stage out of `spp` samples per pixel, by default: a
+/// quarter, at least `least`. One rule for the samplers' `initspp` defaults and for the
+/// share a time plan ([`Sampler::plan_for`]) gives the first stage of what fits.
+pub(crate) fn first_stage_spp(spp: u32, least: u32) -> u32 {
+    (spp / 4).max(least)
+}
+
 /// A source of sample points over the rendering space.
 pub trait Sampler: Send {
     /// The plugin's name (`random`, `stratified`, ...).

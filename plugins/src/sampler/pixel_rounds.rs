@@ -287,6 +287,12 @@ pub(crate) const ROUND_PARAMS: [ParamSpec; 4] = [
     ),
 ];
 
+/// The first round's samples per pixel out of `spp`, by default: the samplers' first-stage
+/// rule with at least 2 (a pixel's first variance) and at most `spp`.
+fn first_round_spp(spp: u32) -> u32 {
+    super::first_stage_spp(spp, 2).min(spp)
+}
+
 /// The sampler of `method`, its budget, first round and rounds read from `params` (the
 /// [`ROUND_PARAMS`]).
 pub(crate) fn build<M: PixelMethod + 'static>(
@@ -299,7 +305,7 @@ pub(crate) fn build<M: PixelMethod + 'static>(
     let init = int_in(
         params,
         "initspp",
-        (spp / 4).max(2).min(spp) as i32,
+        first_round_spp(spp) as i32,
         1..=i64::from(spp),
     )?;
     let rounds = int_in(params, "rounds", 4, 1..=64)?;
@@ -416,7 +422,7 @@ impl<M: PixelMethod> Sampler for PixelRounds<M> {
         let spp = spp.clamp(1, self.spp);
         // The first round, while under way, shrinks to its share (not inside a pass).
         if !self.init_given {
-            self.first.shorten((spp / 4).max(2).min(spp));
+            self.first.shorten(first_round_spp(spp));
         }
         let adaptive = self.space.pixels() * u64::from(spp.saturating_sub(self.first.spp()));
         // Unbiased, the one adaptive round reads the first round alone: none after it.

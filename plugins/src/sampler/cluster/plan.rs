@@ -5,6 +5,7 @@
 //! adapt).
 
 use super::{ClusterSampler, Phase, PixelPattern};
+use crate::sampler::first_stage_spp;
 
 impl ClusterSampler {
     /// The fewest first-stage samples per pixel it can still end that stage at: the passes
@@ -28,7 +29,7 @@ impl ClusterSampler {
             let share = if s.init_given {
                 s.init_spp
             } else {
-                (spp / 4).max(lowest)
+                first_stage_spp(spp, lowest)
             };
             let init = share.max(s.min_spp).max(floor).min(s.init_spp);
             self.settings.init_spp = self.init.cursor_mut().shorten(init);

@@ -83,7 +83,7 @@ impl ClusterSettings {
             // an eighth of the cells, so the sampler costs less (5D, 8 spp: 35% of wall time
             // against 53%).
             bins: 1,
-            init_spp: (spp / 4).max(1),
+            init_spp: crate::sampler::first_stage_spp(spp, 1),
             min_spp: 1,
             max_cluster_cells: 64,
             // Measured with acr bench (docs/BENCHMARKS.md, "Cluster sampler knobs"): over
