@@ -108,6 +108,60 @@ fn an_unbiased_pixels_points_do_not_depend_on_its_own_values() {
     }
 }
 
+/// Every point the sampler gives when each batch is observed before the next is asked (no
+/// planning ahead), on the noiseless field.
+fn points_one_at_a_time(mut s: Box<dyn acr_plugins::Sampler>) -> Vec<SamplePoint> {
+    let (mut all, mut batch) = (Vec::new(), Vec::new());
+    while s.next_batch(&mut batch) {
+        let r: Vec<[f32; 3]> = batch
+            .iter()
+            .map(|q| common::noisy_step(q, 0.0, |_| false))
+            .collect();
+        s.observe(&batch, &r);
+        all.extend_from_slice(&batch);
+    }
+    all
+}
+
+#[test]
+fn the_unbiased_cluster_sampler_plans_every_batch_ahead_and_decides_as_one_at_a_time() {
+    // Each half clusters from the other colour's whole first stage: where the render loop asks
+    // ahead, the half whose other colour is still being traced lets the other half go first,
+    // so no batch waits for a clustering (before, the first half's clustering ran while
+    // nothing was traced), and the decisions are those of asking one batch at a time.
+    for spp in [2, 8, 16] {
+        let mut s = unbiased("cluster", spp);
+        let mut not_ahead = 0;
+        let mut batches = 0;
+        let ahead = acr_plugins::sampler::drive_with(
+            s.as_mut(),
+            |b| {
+                b.iter()
+                    .map(|q| common::noisy_step(q, 0.0, |_| false))
+                    .collect()
+            },
+            |s, _| {
+                batches += 1;
+                not_ahead += usize::from(!s.plans_ahead());
+            },
+        );
+        assert!(
+            batches >= 2 + usize::from(spp > 2) * 2,
+            "{spp}: {batches} batches"
+        );
+        // Only the last batch is traced with nothing planned beside it.
+        assert!(
+            not_ahead <= 1,
+            "{spp}: {not_ahead} of {batches} not planned ahead"
+        );
+        let one = points_one_at_a_time(unbiased("cluster", spp));
+        assert!(
+            sorted(&ahead, |_| true) == sorted(&one, |_| true),
+            "{spp}: planning ahead changed the points"
+        );
+    }
+}
+
 #[test]
 fn an_unbiased_sampler_adapts_and_spends_its_budget_exactly() {
     for name in CROSSED {

@@ -54,8 +54,19 @@ enum Phase {
     Done,
 }
 
-/// A planned round's points' cells (and in-cell offsets) and the clusters it sampled.
-type Round = (Vec<(u32, [f32; MAX_DIMS])>, Vec<u32>);
+/// A planned round, until it is observed.
+#[derive(Default)]
+struct Round {
+    /// How many points it has.
+    points: usize,
+    /// Its points' cells and in-cell offsets, in batch order: kept only by a sampler that
+    /// learns its own rounds' values (see [`ClusterSampler::learns_own_rounds`]).
+    cells: Vec<(u32, [f32; MAX_DIMS])>,
+    /// The clusters it sampled.
+    clusters: Vec<u32>,
+    /// Their queue entries as picked (for [`ClusterSampler::requeue_picked`]).
+    picked: Vec<Queued>,
+}
 
 /// The adaptive cluster sampler.
 pub struct ClusterSampler {
@@ -102,6 +113,8 @@ pub struct ClusterSampler {
     dirty: Vec<u32>,
     cell_updates: Vec<CellUpdate>,
     changes: Vec<Change>,
+    /// The sample counts of the clusters a round picked (reused; see `requeue_picked`).
+    counts: Vec<u64>,
     rounds: u64,
     partition: Option<Partition>,
     /// With `--noise-threshold`: the threshold, and the samples each cell of a cluster needs
@@ -156,6 +169,7 @@ impl ClusterSampler {
             dirty: Vec::new(),
             cell_updates: Vec::new(),
             changes: Vec::new(),
+            counts: Vec::new(),
             rounds: 0,
             partition: None,
             noise: None,
@@ -255,7 +269,13 @@ impl ClusterSampler {
         let target = (self.remaining / 16)
             .clamp(MIN_ROUND, BATCH_SAMPLES)
             .min(self.remaining);
-        let (cells, mut clusters) = self.spare.pop().unwrap_or_default();
+        let Round {
+            cells,
+            mut clusters,
+            mut picked,
+            ..
+        } = self.spare.pop().unwrap_or_default();
+        picked.clear();
         self.round_cells = cells;
         let mut picks: Vec<(u32, u64)> = Vec::new();
         let mut planned_total = 0;
@@ -284,6 +304,7 @@ impl ClusterSampler {
                 .clamp(CLUSTER_SAMPLES.0, CLUSTER_SAMPLES.1)
                 .min(target - planned_total);
             picks.push((top.id, k));
+            picked.push(top);
             planned_total += k;
             top.samples += k;
             let priority = self.priority(&top);
@@ -307,29 +328,47 @@ impl ClusterSampler {
             let (init, grid) = (&self.init, &self.grid);
             let seed = init.seed();
             let stream = self.settings.stream;
-            self.round_cells.resize(out.len(), (0, [0.0; MAX_DIMS]));
-            out.par_iter_mut()
-                .zip(self.round_cells.par_iter_mut())
-                .with_min_len(256)
-                .for_each(|(q, slot)| {
-                    // The pixel's next point of its sequence, labelled with the stream's index.
-                    let local = q.index;
-                    *q = init.point(q.pixel, local, Scramble::of(q.pixel, seed));
-                    q.index = stream.index(local);
-                    let (cell, off) = grid.locate(q);
-                    *slot = (cell as u32, off);
-                });
+            // The pixel's next point of its sequence, labelled with the stream's index.
+            let make = |q: &mut SamplePoint| {
+                let local = q.index;
+                *q = init.point(q.pixel, local, Scramble::of(q.pixel, seed));
+                q.index = stream.index(local);
+            };
+            self.round_cells.clear();
+            if self.learns_own_rounds() {
+                self.round_cells.resize(out.len(), (0, [0.0; MAX_DIMS]));
+                out.par_iter_mut()
+                    .zip(self.round_cells.par_iter_mut())
+                    .with_min_len(256)
+                    .for_each(|(q, slot)| {
+                        make(q);
+                        let (cell, off) = grid.locate(q);
+                        *slot = (cell as u32, off);
+                    });
+            } else {
+                out.par_iter_mut().with_min_len(256).for_each(make);
+            }
         } else {
             let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
             self.draw_cells(&picks, &mut rng, out);
         }
         clusters.clear();
         clusters.extend(picks.iter().map(|&(id, _)| id));
-        let cells = std::mem::take(&mut self.round_cells);
-        self.in_flight.push_back((cells, clusters));
+        self.in_flight.push_back(Round {
+            points: out.len(),
+            cells: std::mem::take(&mut self.round_cells),
+            clusters,
+            picked,
+        });
         self.remaining -= planned_total;
         self.given_adaptive += planned_total;
         self.rounds += 1;
+    }
+
+    /// Whether its own rounds' values come back to it ([`Sampler::observe`]): not for a half
+    /// of an unbiased pair or a stream of a paired sampler, whose values go to the other.
+    fn learns_own_rounds(&self) -> bool {
+        self.settings.colour.is_none() && self.settings.stream == super::IndexStream::ALL
     }
 
     /// The systematic sample of `k` slots over `m` cells from a random start: `k` samples
@@ -587,10 +626,16 @@ impl Sampler for ClusterSampler {
         // An adaptive point's cell is known from when it was made; the first stage's are
         // found here, in parallel.
         let round = match self.in_flight.front() {
-            Some(r) if r.0.len() == batch.len() => self.in_flight.pop_front(),
+            Some(r) if r.points == batch.len() => self.in_flight.pop_front(),
             _ => None,
         };
-        let Some((cells, clusters)) = round else {
+        let Some(Round {
+            points,
+            cells,
+            clusters,
+            picked,
+        }) = round
+        else {
             self.grid.locate_all(batch, &mut self.round_cells);
             self.sums.add_batch(&self.round_cells, radiance, None);
             return;
@@ -604,7 +649,12 @@ impl Sampler for ClusterSampler {
         }
         // A round is one batch: update now.
         let clusters = self.update(clusters);
-        self.spare.push((cells, clusters));
+        self.spare.push(Round {
+            points,
+            cells,
+            clusters,
+            picked,
+        });
         if self.phase == Phase::Done {
             self.finish();
         }
@@ -631,12 +681,17 @@ impl Sampler for ClusterSampler {
         // Its own round, traced for the other stream: only the clusters it sampled are queued
         // again with their new sample counts.
         let round = match self.in_flight.front() {
-            Some(r) if r.0.len() == batch.len() => self.in_flight.pop_front(),
+            Some(r) if r.points == batch.len() => self.in_flight.pop_front(),
             _ => None,
         };
-        if let Some((cells, clusters)) = round {
-            let clusters = self.update(clusters);
-            self.spare.push((cells, clusters));
+        if let Some(mut round) = round {
+            round.clusters = if self.settings.colour.is_some() {
+                // A half of an unbiased pair learns nothing after its first stage.
+                self.requeue_picked(&mut round.picked, round.clusters)
+            } else {
+                self.update(round.clusters)
+            };
+            self.spare.push(round);
         }
         if self.phase == Phase::Done {
             self.finish();

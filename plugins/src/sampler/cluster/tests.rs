@@ -150,6 +150,23 @@ fn each_live_cluster_has_one_current_queue_entry_that_agrees_with_it() {
 }
 
 #[test]
+fn an_unbiased_halfs_queue_entries_agree_with_its_clusters_after_each_round() {
+    // A half of an unbiased pair queues its round's clusters again from the entries it
+    // picked (`requeue_picked`), not from the clusters: those must stay what `entry` makes.
+    let sp = space(0, 0, 48, 32, ALL_DIMS[1]);
+    let half = |colour| ClusterSampler::new(sp, ClusterSettings::new(12), 9).for_colour(colour);
+    let mut pair = crossed::Crossed::new([half(0), half(1)]);
+    let mut b = Vec::new();
+    let mut checked = 0;
+    while pair.next_batch(&mut b) {
+        let r: Vec<[f32; 3]> = b.iter().map(field).collect();
+        pair.observe(&b, &r);
+        checked += pair.halves().iter().map(check_queue).sum::<usize>();
+    }
+    assert!(checked > 1000, "{checked}");
+}
+
+#[test]
 fn every_dims_spends_the_budget_and_stays_in_range() {
     for dims in ALL_DIMS {
         let sp = space(3, 2, 20, 12, dims);

@@ -6,6 +6,7 @@
 use super::ClusterSampler;
 use crate::cluster::features::{level, raw_gradient, raw_variance, Squashed};
 use crate::cluster::grid::MAX_DIMS;
+use crate::cluster::queue::Queued;
 use rayon::prelude::*;
 
 /// Changed cells whose clusters are read ahead of their moves at a time (see
@@ -44,6 +45,12 @@ impl ClusterSampler {
                 dirty.push((w * 64) as u32 + bits.trailing_zeros());
                 *bits &= *bits - 1;
             }
+        }
+        if dirty.is_empty() {
+            // Nothing sampled is learnt (the unbiased pair's halves after their first stage):
+            // the round's clusters are queued again, no more.
+            self.dirty = dirty;
+            return self.requeue(round_clusters);
         }
         let (grid, sums) = (&self.grid, &self.sums);
         let mut empty: Vec<u32> = Vec::new();
@@ -129,33 +136,99 @@ impl ClusterSampler {
             }
         }
         (self.dirty, self.changes) = (dirty, changes);
-        let live = clustering.live();
-        if self.version.len() < clustering.clusters.len() {
-            self.version.resize(clustering.clusters.len(), 0);
-        }
-        // Each changed cluster once, in the order of its first change: a bit per cluster
-        // rather than a sort (4% of the sampler's instructions, by callgrind).
+        self.requeue(changed)
+    }
+
+    /// Queues the clusters `changed` again (each once, in the order of its first listing) with
+    /// new versions, so that their older entries go stale; returns them.
+    fn requeue(&mut self, mut changed: Vec<u32>) -> Vec<u32> {
         let marks = &mut self.cluster_marks;
-        marks.resize(clustering.clusters.len().div_ceil(64), 0);
-        changed.retain(|&id| {
-            let (word, bit) = (id as usize / 64, 1u64 << (id % 64));
-            let first = marks[word] & bit == 0;
-            marks[word] |= bit;
-            first
-        });
-        for &id in &changed {
-            marks[id as usize / 64] &= !(1u64 << (id % 64));
+        first_listed(marks, &mut changed, |&id| id);
+        self.renew(&mut changed);
+        self.push_all(changed.iter().copied());
+        changed
+    }
+
+    /// [`Self::requeue`] for a sampler that learns nothing after its first stage (a half of an
+    /// unbiased pair): its clusters' cells and weights stand, so the entries `picked` in a
+    /// round are queued again as they were but for their new sample counts, without reading
+    /// each cluster's features (which cost a sixth of the sampler's time); the same entries.
+    pub(super) fn requeue_picked(
+        &mut self,
+        picked: &mut Vec<Queued>,
+        mut ids: Vec<u32>,
+    ) -> Vec<u32> {
+        first_listed(&mut self.cluster_marks, picked, |e| e.id);
+        ids.clear();
+        ids.extend(picked.iter().map(|e| e.id));
+        if self.renew(&mut ids) {
+            self.push_all(ids.iter().copied());
+            return ids;
         }
-        for &id in &changed {
+        // The counts first, in a loop of independent reads whose cache misses overlap (read
+        // while queueing, each missed in turn: two thirds of this function's time).
+        let clustering = self.clustering.as_ref().expect("clustered");
+        let mut counts = std::mem::take(&mut self.counts);
+        counts.clear();
+        counts.extend(
+            picked
+                .iter()
+                .map(|e| clustering.clusters[e.id as usize].samples),
+        );
+        for (e, &samples) in picked.iter().zip(&counts) {
+            let e = Queued {
+                version: self.version[e.id as usize],
+                samples,
+                ..*e
+            };
+            self.queue.push(self.priority(&e), e);
+        }
+        self.counts = counts;
+        ids
+    }
+
+    /// New versions for the clusters `changed` (listed once each); where the queue is mostly
+    /// stale entries it is emptied and `changed` becomes every cluster: returns whether.
+    fn renew(&mut self, changed: &mut Vec<u32>) -> bool {
+        let clustering = self.clustering.as_ref().expect("clustered");
+        let (live, count) = (clustering.live(), clustering.clusters.len());
+        if self.version.len() < count {
+            self.version.resize(count, 0);
+        }
+        for &id in changed.iter() {
             self.version[id as usize] = self.version[id as usize].wrapping_add(1);
         }
         if self.queue.len() > 2 * live + 1024 {
             // Mostly stale entries: rebuild.
             self.queue.clear();
             changed.clear();
-            changed.extend(0..self.version.len() as u32);
+            changed.extend(0..count as u32);
+            return true;
         }
-        self.push_all(changed.iter().copied());
-        changed
+        false
+    }
+}
+
+/// Keeps the first of the `items` with each id (`id_of`), in order: a bit per cluster in
+/// `marks` (left clear) rather than a sort (4% of the sampler's instructions, by callgrind).
+fn first_listed<T>(marks: &mut Vec<u64>, items: &mut Vec<T>, id_of: impl Fn(&T) -> u32) {
+    let most = items
+        .iter()
+        .map(|t| id_of(t) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    if marks.len() < most.div_ceil(64) {
+        marks.resize(most.div_ceil(64), 0);
+    }
+    items.retain(|t| {
+        let id = id_of(t);
+        let (word, bit) = (id as usize / 64, 1u64 << (id % 64));
+        let first = marks[word] & bit == 0;
+        marks[word] |= bit;
+        first
+    });
+    for t in items.iter() {
+        let id = id_of(t);
+        marks[id as usize / 64] &= !(1u64 << (id % 64));
     }
 }
