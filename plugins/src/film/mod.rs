@@ -1,0 +1,352 @@
+//! The film: pbrt-v3's image film. Each sample is splatted into every pixel within the filter's
+//! radius, weighted; a pixel's value is its weighted mean. Beside the splats it keeps each
+//! pixel's own samples' count, sum and sum of squares, for the spp and variance AOVs and for
+//! filters that reconstruct from per-pixel statistics.
+
+use crate::cluster::grid::MAX_DIMS;
+use crate::cluster::{CellGrid, CellSums, CellView};
+use crate::first_hit::Features;
+use crate::kernel::FilterKernel;
+use crate::space::SamplePoint;
+use glam::Vec2;
+
+pub use crate::color::{luminance, Spectrum};
+pub use settings::{FilmSettings, MAX_PIXELS, MAX_RESOLUTION};
+use splat::{Prepared, Splat, TABLE_SIZE};
+pub use stats::{relative_error_of, PixelStats};
+
+mod settings;
+mod splat;
+mod stats;
+
+/// Accumulated, filtered samples.
+#[derive(Clone, Debug)]
+pub struct Film {
+    settings: FilmSettings,
+    splat: Splat,
+    sums: Vec<[f64; 4]>,
+    stats: Vec<PixelStats>,
+    /// [`Film::add_samples`]'s prepared samples, kept to reuse the allocation.
+    prepared: Vec<Prepared>,
+    /// Per-cell sums over the rendering space, for a reconstruction that fits cells when the
+    /// sampler keeps none ([`Film::collect_cells`]).
+    cells: Option<(CellGrid, CellSums)>,
+    /// The cell and offsets of each point of the batch being added (reused).
+    located: Vec<(u32, [f32; MAX_DIMS])>,
+    /// The two streams' films, when the samples come in two ([`Film::split_streams`]): the
+    /// splats and cells go there, and this film keeps the pixel statistics of both.
+    halves: Option<Box<[Film; 2]>>,
+    /// The first stream's weight in the image, when split (the second's is 1 minus it).
+    first_weight: f64,
+}
+
+impl Film {
+    /// An empty film.
+    pub fn new(settings: FilmSettings, kernel: &dyn FilterKernel) -> Self {
+        let (w, h) = settings.size();
+        let (rx, ry) = kernel.radius();
+        let mut table = [0.0f32; TABLE_SIZE * TABLE_SIZE];
+        for (i, t) in table.iter_mut().enumerate() {
+            let (x, y) = (i % TABLE_SIZE, i / TABLE_SIZE);
+            *t = kernel.eval(
+                (x as f32 + 0.5) * rx / TABLE_SIZE as f32,
+                (y as f32 + 0.5) * ry / TABLE_SIZE as f32,
+            );
+        }
+        let [cx0, cx1, _, _] = settings.crop;
+        Self {
+            sums: vec![[0.0; 4]; w as usize * h as usize],
+            stats: vec![PixelStats::default(); w as usize * h as usize],
+            splat: Splat {
+                table,
+                radius: (rx, ry),
+                columns: (cx0 as i64, cx1 as i64),
+            },
+            settings,
+            prepared: Vec::new(),
+            cells: None,
+            located: Vec::new(),
+            halves: None,
+            first_weight: 0.5,
+        }
+    }
+
+    /// Keeps the two sample streams of a paired sampler apart (a sample's stream is its
+    /// index's parity): each gets a film of its own, and the image is their blend with the
+    /// fixed weights `first_weight` and 1 minus it, so that neither stream's share of a pixel
+    /// depends on the values. Called before any sample is added.
+    pub fn split_streams(&mut self, first_weight: f64) {
+        self.first_weight = first_weight.clamp(0.0, 1.0);
+        if self.halves.is_some() {
+            return;
+        }
+        let half = self.clone();
+        // The splats and cells live in the halves only.
+        self.cells = None;
+        self.sums = Vec::new();
+        self.halves = Some(Box::new([half.clone(), half]));
+    }
+
+    /// The two streams' films, when split.
+    pub fn halves(&self) -> Option<&[Film; 2]> {
+        self.halves.as_deref()
+    }
+
+    /// The image `image` makes of this film, or when it is split, the blend of the images it
+    /// makes of each stream's film (`image` gets the stream's number) with the weights of
+    /// [`Film::split_streams`]. A pixel one stream left without a sample (a time limit that
+    /// stopped it, dropped samples) takes the other's alone.
+    pub fn per_stream(&self, image: impl Fn(&Film, usize) -> Vec<Spectrum>) -> Vec<Spectrum> {
+        match self.halves() {
+            Some([a, b]) => {
+                let w = self.first_weight as f32;
+                image(a, 0)
+                    .into_iter()
+                    .zip(image(b, 1))
+                    .zip(a.stats.iter().zip(&b.stats))
+                    .map(|((x, y), (sa, sb))| match (sa.count, sb.count) {
+                        (0, n) if n > 0 => y,
+                        (n, 0) if n > 0 => x,
+                        _ => x * w + y * (1.0 - w),
+                    })
+                    .collect()
+            }
+            None => image(self, 0),
+        }
+    }
+
+    /// Adds samples of stream `stream` (raster position and radiance, sorted by row) to that
+    /// stream's film, and their statistics to this one's; the same as
+    /// [`Film::add_samples`] when the film is not split.
+    pub fn add_stream_samples(&mut self, stream: usize, samples: &[(Vec2, Spectrum)]) {
+        match self.halves.as_mut() {
+            Some(h) => {
+                h[stream & 1].add_samples(samples);
+                self.add_stats(samples);
+            }
+            None => self.add_samples(samples),
+        }
+    }
+
+    /// Makes the film also keep running sums per cell of `grid` ([`Film::add_points`]), with
+    /// the samples' first-hit features when `features`.
+    pub fn collect_cells(&mut self, grid: CellGrid, features: bool) {
+        let sums = CellSums::new(&grid);
+        let sums = if features { sums.with_features() } else { sums };
+        self.cells = Some((grid, sums));
+    }
+
+    /// Adds each point of `batch` with its radiance (and first-hit features, when given) to
+    /// its cell, when the film collects cells; NaN radiance marks a dropped sample and is
+    /// skipped.
+    pub fn add_points(
+        &mut self,
+        batch: &[SamplePoint],
+        radiance: &[[f32; 3]],
+        features: Option<&[Features]>,
+    ) {
+        if let Some(h) = self.halves.as_mut() {
+            // Each stream's points to its own film's cells, in order.
+            for (s, half) in h.iter_mut().enumerate() {
+                let keep = |k: &usize| batch[*k].index as usize & 1 == s;
+                let ks: Vec<usize> = (0..batch.len()).filter(keep).collect();
+                let b: Vec<SamplePoint> = ks.iter().map(|&k| batch[k]).collect();
+                let r: Vec<[f32; 3]> = ks.iter().map(|&k| radiance[k]).collect();
+                let f: Option<Vec<Features>> = features.map(|f| ks.iter().map(|&k| f[k]).collect());
+                half.add_points(&b, &r, f.as_deref());
+            }
+            return;
+        }
+        let Some((grid, sums)) = self.cells.as_mut() else {
+            return;
+        };
+        grid.locate_all(batch, &mut self.located);
+        sums.add_batch(&self.located, radiance, features);
+    }
+
+    /// Whether the film's cells keep the samples' first-hit features ([`Film::collect_cells`]).
+    pub fn collects_features(&self) -> bool {
+        if let Some(h) = &self.halves {
+            return h[0].collects_features();
+        }
+        self.cells
+            .as_ref()
+            .is_some_and(|(_, sums)| sums.keeps_features())
+    }
+
+    /// The film's cells, when it collects them.
+    pub fn cells(&self) -> Option<CellView<'_>> {
+        self.cells.as_ref().map(|(grid, sums)| CellView {
+            grid,
+            sums,
+            clustering: None,
+        })
+    }
+
+    /// The settings it was made with.
+    pub fn settings(&self) -> &FilmSettings {
+        &self.settings
+    }
+
+    /// Adds a sample at raster position `p` (full-resolution pixels) with radiance `l`, into
+    /// every pixel whose centre is within the filter radius (pbrt-v3's Film::AddSample, with
+    /// its tabulated filter). The radiance is taken as given: the render loop applies the
+    /// film's limits ([`FilmSettings::clamp`]) once, before the sampler, the cells and the film
+    /// see a sample.
+    pub fn add_sample(&mut self, p: Vec2, l: Spectrum) {
+        let [_, _, cy0, cy1] = self.settings.crop;
+        let ry = self.splat.radius.1;
+        let dy = p.y - 0.5;
+        let y0 = ((dy - ry).ceil() as i64).max(cy0 as i64);
+        let y1 = ((dy + ry).floor() as i64 + 1).min(cy1 as i64);
+        let w = self.settings.size().0 as usize;
+        if let Some(i) = self.pixel_index(p) {
+            self.stats[i].add(l);
+        }
+        for y in y0..y1 {
+            let start = (y - cy0 as i64) as usize * w;
+            self.splat.row(&mut self.sums[start..start + w], y, p, l);
+        }
+    }
+
+    /// Adds samples in order: each pixel receives its contributions in the order given, so the
+    /// result equals adding them one by one, whatever the thread count. The samples must be
+    /// sorted by raster row (`floor(p.y)`), as the render loop produces them; rows are then
+    /// filled in parallel, each from the samples within the filter's reach.
+    pub fn add_samples(&mut self, samples: &[(Vec2, Spectrum)]) {
+        use rayon::prelude::*;
+        debug_assert!(samples
+            .windows(2)
+            .all(|w| w[0].0.y.floor() <= w[1].0.y.floor()));
+        let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
+            return;
+        };
+        self.add_stats(samples);
+        let cy0 = self.settings.crop[2] as i64;
+        let ry = self.splat.radius.1;
+        // Sorted by whole rows only: the extreme positions are bounded by the rows' edges.
+        let (lo, hi) = (first.0.y.floor() - 0.5 - ry, last.0.y.floor() + 0.5 + ry);
+        let w = self.settings.size().0 as usize;
+        let splat = &self.splat;
+        if splat.prepare_pays() {
+            samples
+                .par_iter()
+                .map(|&(p, l)| splat.prepare(p, l))
+                .collect_into_vec(&mut self.prepared);
+            let prepared = &self.prepared;
+            self.sums
+                .par_chunks_mut(w)
+                .enumerate()
+                .for_each(|(row_index, row)| {
+                    let y = row_index as i64 + cy0;
+                    let yf = y as f32;
+                    if yf < lo || yf > hi {
+                        return;
+                    }
+                    // As below.
+                    let (top, bottom) = ((yf + 0.5 - ry).floor(), (yf + 0.5 + ry).floor());
+                    let from = prepared.partition_point(|s| s.p.y.floor() < top);
+                    let to = prepared.partition_point(|s| s.p.y.floor() <= bottom);
+                    for s in &prepared[from..to] {
+                        splat.row_prepared(row, y, s);
+                    }
+                });
+            return;
+        }
+        self.sums
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(row_index, row)| {
+                let y = row_index as i64 + cy0;
+                let yf = y as f32;
+                if yf < lo || yf > hi {
+                    return;
+                }
+                // A superset, by whole raster rows (monotone in the sorted samples), of the
+                // samples whose filter reaches row y (|y - (p.y - 0.5)| <= ry).
+                let (top, bottom) = ((yf + 0.5 - ry).floor(), (yf + 0.5 + ry).floor());
+                let from = samples.partition_point(|(p, _)| p.y.floor() < top);
+                let to = samples.partition_point(|(p, _)| p.y.floor() <= bottom);
+                for &(p, l) in &samples[from..to] {
+                    splat.row(row, y, p, l);
+                }
+            });
+    }
+
+    /// Adds row-sorted samples to the statistics of the pixels they lie in, rows in parallel.
+    fn add_stats(&mut self, samples: &[(Vec2, Spectrum)]) {
+        use rayon::prelude::*;
+        let [cx0, cx1, cy0, _] = self.settings.crop;
+        let w = (cx1 - cx0) as usize;
+        self.stats
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(row_index, row)| {
+                let y = (row_index as u32 + cy0) as f32;
+                let from = samples.partition_point(|(p, _)| p.y.floor() < y);
+                let to = samples.partition_point(|(p, _)| p.y.floor() <= y);
+                for &(p, l) in &samples[from..to] {
+                    let x = p.x.floor();
+                    if x >= cx0 as f32 && x < cx1 as f32 {
+                        row[(x - cx0 as f32) as usize].add(l);
+                    }
+                }
+            });
+    }
+
+    /// The index into the cropped image of the pixel holding raster position `p`, if any.
+    fn pixel_index(&self, p: Vec2) -> Option<usize> {
+        let [cx0, cx1, cy0, cy1] = self.settings.crop;
+        let (x, y) = (p.x.floor(), p.y.floor());
+        let inside = x >= cx0 as f32 && x < cx1 as f32 && y >= cy0 as f32 && y < cy1 as f32;
+        inside.then(|| (y as u32 - cy0) as usize * (cx1 - cx0) as usize + (x as u32 - cx0) as usize)
+    }
+
+    /// Each pixel's own samples, row-major over the cropped image.
+    pub fn pixel_stats(&self) -> &[PixelStats] {
+        &self.stats
+    }
+
+    /// Each pixel's filter-weighted sums of radiance and its sum of filter weights, [r, g, b,
+    /// w], row-major: what renders of different sample ranges add to merge (`None` when the
+    /// streams are split: the image is then a mean of two films).
+    pub fn weighted_sums(&self) -> Option<&[[f64; 4]]> {
+        self.halves.is_none().then_some(self.sums.as_slice())
+    }
+
+    /// Frees the filter-weighted sums (and the streams' films), once the image is made and
+    /// nothing will merge them: they are the largest part of the film (32 bytes a pixel), and
+    /// the output is written after. [`Film::pixels`] and [`Film::weighted_sums`] are then empty.
+    pub fn release_sums(&mut self) {
+        self.sums = Vec::new();
+        self.halves = None;
+    }
+
+    /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
+    /// `scale` is applied on output, not here).
+    pub fn pixels(&self) -> Vec<Spectrum> {
+        if self.halves.is_some() {
+            return self.per_stream(|f, _| f.pixels());
+        }
+        self.sums
+            .iter()
+            .map(|s| {
+                if s[3] != 0.0 {
+                    let inv = 1.0 / s[3];
+                    // Negative lobes (Mitchell, sinc) can make a mean slightly negative.
+                    Spectrum::new(
+                        (s[0] * inv) as f32,
+                        (s[1] * inv) as f32,
+                        (s[2] * inv) as f32,
+                    )
+                    .max(Spectrum::ZERO)
+                } else {
+                    Spectrum::ZERO
+                }
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests;

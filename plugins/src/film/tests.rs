@@ -1,0 +1,163 @@
+//! The film's tests.
+
+use super::splat::{ceil_i64, floor_i64, table_index};
+use super::*;
+use crate::filters::{BoxFilter, GaussianFilter};
+
+/// The f32 running statistics agree with sums in f64, also where the mean is large against
+/// the spread (where E[x^2] - E[x]^2 in f32 would cancel to noise): the variance within
+/// 0.5% when the spread is 1e-5 of the level (pbrt-v4 keeps its variance in f32 too),
+/// 0.1% otherwise.
+#[test]
+fn pixel_statistics_keep_their_precision() {
+    for (level, spread, tolerance) in [
+        (1000.0f64, 0.01f64, 5e-3),
+        (0.5, 0.4, 1e-3),
+        (1e-3, 1e-3, 1e-3),
+    ] {
+        let mut stats = PixelStats::default();
+        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+        let n = 10_000;
+        for i in 0..n {
+            // A deterministic, irregular sequence around `level`.
+            let x = (level + spread * ((i as f64 * 0.618_034).fract() - 0.5)) as f32;
+            stats.add(Spectrum::new(x, x, x));
+            sum += f64::from(x);
+            sum_sq += f64::from(x) * f64::from(x);
+        }
+        let mean = sum / n as f64;
+        let var_of_mean = (sum_sq / n as f64 - mean * mean) / (n as f64 - 1.0);
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+        assert!(rel(f64::from(stats.mean().x), mean) < 1e-6, "{level}");
+        assert!(rel(stats.sum()[0], sum) < 1e-6, "{level}");
+        assert!(rel(stats.sum_sq()[0], sum_sq) < 1e-6, "{level}");
+        let v = f64::from(stats.variance_of_mean().x);
+        assert!(
+            rel(v, var_of_mean) < tolerance,
+            "{level}: {v} against {var_of_mean}"
+        );
+    }
+}
+
+#[test]
+fn integer_rounding_matches_libm() {
+    let values = [
+        0.0f32,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        1.5,
+        -1.5,
+        2.999_999_8,
+        -2.999_999_8,
+        1e7 + 0.5,
+        3.0e9,
+        -3.0e9,
+        1e30,
+        -1e30,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    for v in values {
+        assert_eq!(ceil_i64(v), v.ceil() as i64, "ceil {v}");
+        assert_eq!(floor_i64(v), v.floor() as i64, "floor {v}");
+    }
+    for r in [
+        0.0f32,
+        0.03,
+        0.5,
+        0.937_5,
+        0.999_99,
+        1.0,
+        1.2,
+        1e9,
+        f32::INFINITY,
+    ] {
+        let want = ((r * TABLE_SIZE as f32) as usize).min(TABLE_SIZE - 1);
+        assert_eq!(table_index(r) as usize, want, "{r}");
+    }
+}
+
+/// Releasing the sums frees them and keeps the per-pixel statistics the output still reads.
+#[test]
+fn released_sums_leave_the_statistics() {
+    let mut f = Film::new(
+        FilmSettings::with_resolution(2, 1),
+        &BoxFilter::new(0.5, 0.5),
+    );
+    f.add_sample(Vec2::new(0.25, 0.5), Spectrum::splat(1.0));
+    f.add_sample(Vec2::new(1.5, 0.5), Spectrum::splat(5.0));
+    let stats = f.pixel_stats().to_vec();
+    f.release_sums();
+    assert_eq!(f.weighted_sums(), Some(&[][..]));
+    assert!(f.pixels().is_empty());
+    assert_eq!(f.pixel_stats(), &stats[..]);
+}
+
+#[test]
+fn box_filter_averages_samples_in_the_pixel() {
+    let mut f = Film::new(
+        FilmSettings::with_resolution(2, 1),
+        &BoxFilter::new(0.5, 0.5),
+    );
+    f.add_sample(Vec2::new(0.25, 0.5), Spectrum::splat(1.0));
+    f.add_sample(Vec2::new(0.75, 0.5), Spectrum::splat(3.0));
+    f.add_sample(Vec2::new(1.5, 0.5), Spectrum::splat(5.0));
+    let p = f.pixels();
+    assert_eq!(p[0], Spectrum::splat(2.0));
+    assert_eq!(p[1], Spectrum::splat(5.0));
+    let st = f.pixel_stats();
+    assert_eq!((st[0].count, st[1].count), (2, 1));
+    assert_eq!(st[0].mean(), Spectrum::splat(2.0));
+    // Samples 1 and 3: sample variance 2, variance of the mean 1.
+    assert_eq!(st[0].variance_of_mean(), Spectrum::splat(1.0));
+    assert_eq!(st[1].variance_of_mean(), Spectrum::ZERO);
+}
+
+#[test]
+fn batch_adding_equals_one_by_one() {
+    use crate::filters::MitchellFilter;
+    let kernel = MitchellFilter::new(2.0, 1.5, 1.0 / 3.0, 1.0 / 3.0);
+    let mut s = FilmSettings::with_resolution(9, 7);
+    s.crop = [1, 8, 1, 6];
+    let mut one = Film::new(s.clone(), &kernel);
+    let mut batch = Film::new(s, &kernel);
+    // Row-sorted samples, several per pixel, with varied values.
+    let mut samples = Vec::new();
+    for py in 0..7u32 {
+        for px in 0..9u32 {
+            for k in 0..3u32 {
+                let u = Vec2::new(
+                    (k as f32 * 0.37 + px as f32 * 0.11) % 1.0,
+                    (k as f32 * 0.61) % 1.0,
+                );
+                let l = Spectrum::new(px as f32, py as f32, k as f32 + 1.0);
+                samples.push((Vec2::new(px as f32, py as f32) + u, l));
+            }
+        }
+    }
+    for &(p, l) in &samples {
+        one.add_sample(p, l);
+    }
+    batch.add_samples(&samples[..100]);
+    batch.add_samples(&samples[100..]);
+    assert_eq!(one.pixels(), batch.pixels());
+    assert_eq!(one.pixel_stats(), batch.pixel_stats());
+    assert_eq!(batch.pixel_stats()[0].count, 3);
+}
+
+#[test]
+fn wide_filter_reaches_neighbours_and_crop_limits_output() {
+    let mut s = FilmSettings::with_resolution(4, 4);
+    s.crop = [1, 3, 1, 3];
+    let mut f = Film::new(s, &GaussianFilter::new(2.0, 2.0, 2.0));
+    f.add_sample(Vec2::new(1.5, 1.5), Spectrum::new(1.0, 2.0, 3.0));
+    let p = f.pixels();
+    assert_eq!(p.len(), 4);
+    for v in p {
+        assert!((v - Spectrum::new(1.0, 2.0, 3.0)).length() < 1e-6);
+    }
+}
