@@ -223,7 +223,7 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     assert_eq!(
         lines[0],
         "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
-         mean_ratio"
+         mean_ratio,seeds"
     );
     assert_eq!(lines.len(), 11);
     let ok: Vec<&str> = lines[1..]
@@ -264,6 +264,61 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     // The reference is cached: a second run does not render it again.
     let err = run();
     assert!(!err.contains("rendering the reference"), "{err}");
+}
+
+#[test]
+fn bench_rows_over_seeds_are_the_means_of_each_seed_s_rows() {
+    let dir = TempDir::new("bench-seeds");
+    dir.write("s.pbrt", &small_scene(""));
+    let manifest = |seeds: &str| {
+        format!(
+            "{seeds}\nthreads = 2\n[budgets]\nspp = [2]\nequal_time = true\n\
+             [reference]\nsampler = \"sobol\"\nfilter = \"box\"\nspp = 32\n\
+             [[scene]]\nname = \"small\"\npath = \"s.pbrt\"\n\
+             [[method]]\nlabel = \"random+box\"\nsampler = \"random\"\nfilter = \"box\"\n\
+             [[method]]\nlabel = \"stratified+box\"\nsampler = \"stratified\"\nfilter = \"box\"\n"
+        )
+    };
+    // The equal-spp rows: MSE and the seeds column, by method.
+    let rows = |name: &str, seeds: &str| {
+        let out = dir.join(name);
+        bench_ok(&dir.write(&format!("{name}.toml"), &manifest(seeds)), &out);
+        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+        let rows: Vec<(String, f64, String)> = csv
+            .lines()
+            .filter(|l| l.contains(",equal-spp,"))
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                (f[1].to_owned(), f[7].parse().unwrap(), f[13].to_owned())
+            })
+            .collect();
+        (rows, out)
+    };
+    // `seed` keeps the reference the same for all three.
+    let (one, _) = rows("one", "seed = 7\nseeds = [1]");
+    let (two, _) = rows("two", "seed = 7\nseeds = [2]");
+    let (both, out) = rows("both", "seed = 7\nseeds = [1, 2]");
+    assert_eq!(both.len(), 2);
+    for ((a, b), c) in one.iter().zip(&two).zip(&both) {
+        assert_eq!((&a.0, &a.2, &c.2), (&c.0, &"1".to_owned(), &"2".to_owned()));
+        let mean = (a.1 + b.1) / 2.0;
+        assert!(
+            (c.1 - mean).abs() <= 1e-5 * mean,
+            "{}: {} against {mean}",
+            c.0,
+            c.1
+        );
+    }
+    // Each seed's run keeps its image; the report names the seeds.
+    for seed in [1, 2] {
+        let run = format!("small-stratified_box-2-equal-time-seed{seed}.exr");
+        assert!(out.join("runs").join(&run).is_file(), "{run}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("- seeds: 1, 2 (each row the means"),
+        "{report}"
+    );
 }
 
 #[test]

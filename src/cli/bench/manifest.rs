@@ -11,9 +11,14 @@ pub struct Manifest {
     /// A title for the report.
     #[serde(default)]
     pub title: Option<String>,
-    /// Seed of every run.
+    /// Seed of every run (of the references and the sampler-cost runs, when `seeds` is given).
     #[serde(default)]
     pub seed: u64,
+    /// Seeds of the compared runs: each run is made once per seed and its row holds the means
+    /// over them, so that time-limited rows move less from one bench to the next (default:
+    /// `seed` alone).
+    #[serde(default)]
+    pub seeds: Option<Vec<u64>>,
     /// Worker threads per run (default: every core).
     #[serde(default)]
     pub threads: Option<u32>,
@@ -55,6 +60,16 @@ fn five() -> u32 {
 
 /// Most processes per scene, method and budget in a sampler-cost measure.
 const MAX_COST_RUNS: u32 = 100;
+
+/// Most seeds a compared run is averaged over.
+const MAX_SEEDS: usize = 64;
+
+impl Manifest {
+    /// The seeds of the compared runs: `seeds`, or `seed` alone.
+    pub fn run_seeds(&self) -> Vec<u64> {
+        self.seeds.clone().unwrap_or_else(|| vec![self.seed])
+    }
+}
 
 /// Samples per pixel to run at, and whether to run equal-time too.
 #[derive(Clone, Debug, Deserialize)]
@@ -245,6 +260,15 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
                 "{}: sampler_cost runs {} is out of range (1 to {MAX_COST_RUNS})",
                 path.display(),
                 c.runs
+            ));
+        }
+    }
+    if let Some(seeds) = &m.seeds {
+        let distinct: std::collections::HashSet<_> = seeds.iter().collect();
+        if seeds.is_empty() || seeds.len() > MAX_SEEDS || distinct.len() < seeds.len() {
+            return Err(format!(
+                "{}: seeds must list 1 to {MAX_SEEDS} different seeds",
+                path.display()
             ));
         }
     }

@@ -29,7 +29,9 @@ pub struct Row {
     pub mode: Mode,
     /// The budget (equal-time: the budget whose baseline time it was given).
     pub spp: u32,
-    /// What the run measured, or why it failed.
+    /// How many seeds its figures are the means over.
+    pub seeds: usize,
+    /// What the run measured (the means over its seeds), or why it (one of them) failed.
     pub outcome: Result<Measured, String>,
 }
 
@@ -84,6 +86,28 @@ struct CostSummary {
     rerender: f64,
     /// The median seconds of a replay.
     replay: f64,
+}
+
+impl Measured {
+    /// The means of `runs` (one per seed; the largest peak memory), or the first failure.
+    fn mean_of(runs: Vec<Result<Measured, String>>) -> Result<Measured, String> {
+        let runs = runs.into_iter().collect::<Result<Vec<_>, String>>()?;
+        let n = runs.len().max(1) as f64;
+        let mean = |f: fn(&Measured) -> f64| runs.iter().map(f).sum::<f64>() / n;
+        Ok(Measured {
+            seconds: mean(|r| r.seconds),
+            samples: mean(|r| r.samples as f64).round() as u64,
+            spp_reached: mean(|r| r.spp_reached),
+            metrics: Metrics {
+                mse: mean(|r| r.metrics.mse),
+                relmse: mean(|r| r.metrics.relmse),
+                psnr: mean(|r| r.metrics.psnr),
+                mean: mean(|r| r.metrics.mean),
+                reference_mean: mean(|r| r.metrics.reference_mean),
+            },
+            peak_rss_mb: runs.iter().map(|r| r.peak_rss_mb).fold(0.0, f64::max),
+        })
+    }
 }
 
 impl CostRow {
@@ -306,6 +330,7 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
                 0
             });
     let total = per_scene * m.scenes.len();
+    let seeds = m.run_seeds();
     let mut done = 0;
     let mut rows = Vec::new();
     for scene in &m.scenes {
@@ -318,9 +343,10 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
             }
         };
         for &spp in &m.budgets.spp {
-            let mut baseline_seconds = None;
+            // Per seed: the first method's seconds, the time limit of that seed's runs.
+            let mut baseline_seconds: Vec<Option<f64>> = vec![None; seeds.len()];
             for (k, method) in m.methods.iter().enumerate() {
-                let mut own_seconds = None;
+                let mut own_seconds: Vec<Option<f64>> = vec![None; seeds.len()];
                 let modes: &[Mode] = if k > 0 && m.budgets.equal_time {
                     &[Mode::EqualSpp, Mode::EqualTime]
                 } else {
@@ -328,46 +354,57 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
                 };
                 for &mode in modes {
                     done += 1;
-                    let out = runs_dir.join(format!(
-                        "{}-{}-{spp}-{}.exr",
-                        file_safe(&scene.name),
-                        file_safe(&method.label),
-                        mode.name()
-                    ));
-                    let outcome = match (&reference, mode, baseline_seconds) {
-                        (Err(e), _, _) => Err(e.clone()),
-                        (Ok(_), Mode::EqualTime, None) => {
-                            Err("the first method failed at this budget".to_owned())
+                    let mut runs = Vec::with_capacity(seeds.len());
+                    for (i, &seed) in seeds.iter().enumerate() {
+                        // One seed keeps the file names of before.
+                        let tag = if seeds.len() > 1 {
+                            format!("-seed{seed}")
+                        } else {
+                            String::new()
+                        };
+                        let out = runs_dir.join(format!(
+                            "{}-{}-{spp}-{}{tag}.exr",
+                            file_safe(&scene.name),
+                            file_safe(&method.label),
+                            mode.name()
+                        ));
+                        let outcome = match (&reference, mode, baseline_seconds[i]) {
+                            (Err(e), _, _) => Err(e.clone()),
+                            (Ok(_), Mode::EqualTime, None) => {
+                                Err("the first method failed at this budget".to_owned())
+                            }
+                            (Ok(reference), _, baseline) => {
+                                let (run_spp, limit) = match mode {
+                                    Mode::EqualSpp => (spp, None),
+                                    Mode::EqualTime => (
+                                        m.budgets.time_limited_spp.unwrap_or_else(|| {
+                                            equal_time_spp(spp, baseline, own_seconds[i])
+                                        }),
+                                        baseline,
+                                    ),
+                                };
+                                measure(
+                                    opts,
+                                    &scene_path,
+                                    &out,
+                                    method,
+                                    run_spp,
+                                    seed,
+                                    m.threads,
+                                    limit,
+                                    reference,
+                                )
+                            }
+                        };
+                        if k == 0 {
+                            baseline_seconds[i] = outcome.as_ref().ok().map(|r| r.seconds);
                         }
-                        (Ok(reference), _, _) => {
-                            let (run_spp, limit) = match mode {
-                                Mode::EqualSpp => (spp, None),
-                                Mode::EqualTime => (
-                                    m.budgets.time_limited_spp.unwrap_or_else(|| {
-                                        equal_time_spp(spp, baseline_seconds, own_seconds)
-                                    }),
-                                    baseline_seconds,
-                                ),
-                            };
-                            measure(
-                                opts,
-                                &scene_path,
-                                &out,
-                                method,
-                                run_spp,
-                                m.seed,
-                                m.threads,
-                                limit,
-                                reference,
-                            )
+                        if mode == Mode::EqualSpp {
+                            own_seconds[i] = outcome.as_ref().ok().map(|r| r.seconds);
                         }
-                    };
-                    if k == 0 {
-                        baseline_seconds = outcome.as_ref().ok().map(|r| r.seconds);
+                        runs.push(outcome);
                     }
-                    if mode == Mode::EqualSpp {
-                        own_seconds = outcome.as_ref().ok().map(|r| r.seconds);
-                    }
+                    let outcome = Measured::mean_of(runs);
                     match &outcome {
                         Ok(r) => eprintln!(
                             "[{done}/{total}] {} {} {spp} spp {}: {:.3} s, {:.1} spp, MSE {:.4e}, relMSE {:.4e}",
@@ -391,6 +428,7 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
                         method: method.label.clone(),
                         mode,
                         spp,
+                        seeds: seeds.len(),
                         outcome,
                     });
                 }
@@ -697,6 +735,16 @@ mod tests {
             m.methods[0].time_plan,
             Some(crate::cli::render::TimePlan::Budget)
         );
+        // Seeds to average over: listed once each.
+        for seeds in ["seeds = []", "seeds = [1, 2, 1]"] {
+            std::fs::write(&p, format!("{seeds}\n{}", with("", ""))).unwrap();
+            let e = read_manifest(&p).unwrap_err();
+            assert!(e.contains("seeds must list 1 to 64 different seeds"), "{e}");
+        }
+        std::fs::write(&p, format!("seeds = [4, 2]\n{}", with("", ""))).unwrap();
+        assert_eq!(read_manifest(&p).unwrap().run_seeds(), [4, 2]);
+        std::fs::write(&p, format!("seed = 5\n{}", with("", ""))).unwrap();
+        assert_eq!(read_manifest(&p).unwrap().run_seeds(), [5]);
         std::fs::write(&p, with("time_limited_spp = 0", "")).unwrap();
         let e = read_manifest(&p).unwrap_err();
         assert!(e.contains("time_limited_spp is out of range"), "{e}");

@@ -24,7 +24,7 @@ fn mean_ratio(m: &crate::metrics::Metrics) -> f64 {
 pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
     let mut s = String::from(
         "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
-         mean_ratio\n",
+         mean_ratio,seeds\n",
     );
     for r in rows {
         let head = format!(
@@ -38,7 +38,7 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
             Ok(m) => {
                 let _ = writeln!(
                     s,
-                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok,{:.5}",
+                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok,{:.5},{}",
                     m.seconds,
                     m.samples,
                     m.spp_reached,
@@ -46,11 +46,17 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
                     m.metrics.relmse,
                     m.metrics.psnr,
                     m.peak_rss_mb,
-                    mean_ratio(&m.metrics)
+                    mean_ratio(&m.metrics),
+                    r.seeds
                 );
             }
             Err(e) => {
-                let _ = writeln!(s, "{head},,,,,,,,{},", csv_field(&format!("failed: {e}")));
+                let _ = writeln!(
+                    s,
+                    "{head},,,,,,,,{},,{}",
+                    csv_field(&format!("failed: {e}")),
+                    r.seeds
+                );
             }
         }
     }
@@ -110,7 +116,19 @@ pub fn report_markdown(
         )
     );
     let _ = writeln!(s, "- commit: {}", opts.commit);
-    let _ = writeln!(s, "- seed: {}", m.seed);
+    match &m.seeds {
+        Some(seeds) => {
+            let list: Vec<String> = seeds.iter().map(u64::to_string).collect();
+            let _ = writeln!(
+                s,
+                "- seeds: {} (each row the means over them; the largest peak memory)",
+                list.join(", ")
+            );
+        }
+        None => {
+            let _ = writeln!(s, "- seed: {}", m.seed);
+        }
+    }
     let _ = writeln!(
         s,
         "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds as `--time-limit` (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
