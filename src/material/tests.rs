@@ -1,9 +1,12 @@
 //! Tests of the materials: building from scene descriptions, lobes, defaults and errors.
 
+use super::build::{used_materials, MaterialBuilder};
 use super::*;
 use crate::bsdf::check::*;
 use crate::geometry::{Vec2, Vec3};
-use acr_parser::parse_str;
+use crate::texture::TextureBuilder;
+use acr_parser::{parse_str, Error, Warning};
+use std::path::Path;
 
 fn si() -> SurfaceInteraction {
     SurfaceInteraction::flat(Vec3::new(0.1, 0.2, 0.0), Vec2::new(0.3, 0.6))

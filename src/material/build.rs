@@ -1,0 +1,266 @@
+//! Materials from the scene description: each built once, on demand (a mix builds the two it
+//! blends), with its textures; unknown types and unsupported parameters reported where they
+//! are written.
+
+use super::{Material, COPPER_ETA, COPPER_K};
+use crate::geometry::Spectrum;
+use crate::texture::{Texture, TextureBuilder};
+use acr_parser::{Error, MaterialDesc, ParamList, Result, SceneDescription, Warning};
+use std::path::Path;
+use std::sync::Arc;
+
+/// Material types acr builds.
+const KINDS: [&str; 12] = [
+    "matte",
+    "translucent",
+    "plastic",
+    "mirror",
+    "glass",
+    "metal",
+    "uber",
+    "substrate",
+    "hair",
+    "disney",
+    "mix",
+    "fourier",
+];
+/// pbrt-v3 material types acr replaces by a matte.
+const UNSUPPORTED_KINDS: [&str; 2] = ["subsurface", "kdsubsurface"];
+/// Types that make no surface: rays pass through.
+const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
+/// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
+const UNSUPPORTED_PARAMS: [&str; 2] = ["displacement", "normalmap"];
+
+/// Builds materials from their descriptions, textures on demand.
+pub(super) struct MaterialBuilder<'a> {
+    pub(super) desc: &'a SceneDescription,
+    pub(super) textures: TextureBuilder<'a>,
+    pub(super) built: Vec<Option<Arc<Material>>>,
+    pub(super) in_progress: Vec<bool>,
+}
+
+impl<'a> MaterialBuilder<'a> {
+    pub(super) fn build(&mut self, index: usize) -> Result<Arc<Material>> {
+        if let Some(m) = &self.built[index] {
+            return Ok(Arc::clone(m));
+        }
+        let md: &'a MaterialDesc = &self.desc.materials[index];
+        if self.in_progress[index] {
+            return Err(Error::at(
+                &md.plugin.loc,
+                "mix material refers to itself through its named materials",
+            ));
+        }
+        self.in_progress[index] = true;
+        let mut m = Arc::new(self.make(md)?);
+        let p = &md.plugin.params;
+        // pbrt-v3's hair reads no bumpmap (left unused, so reported as such).
+        if !m.is_interface() && !matches!(*m, Material::Hair(_)) {
+            if let Some(map) = self.textures.float_param_opt(p, "bumpmap")? {
+                m = Arc::new(Material::Bumped {
+                    map: Arc::new(map),
+                    inner: m,
+                });
+            }
+        }
+        self.in_progress[index] = false;
+        self.built[index] = Some(Arc::clone(&m));
+        Ok(m)
+    }
+
+    fn make(&mut self, md: &'a MaterialDesc) -> Result<Material> {
+        let p: &ParamList = &md.plugin.params;
+        let loc = &md.plugin.loc;
+        let kind = md.plugin.kind.as_str();
+        for name in UNSUPPORTED_PARAMS {
+            if let Some(param) = p.get(name) {
+                self.textures.warn_once(
+                    format!("material parameter {name}"),
+                    &param.loc,
+                    format!("material parameter \"{name}\" is not supported; ignored"),
+                );
+            }
+        }
+        let t = &mut self.textures;
+        let remap = |p: &ParamList| p.bool_or("remaproughness", true);
+        Ok(match kind {
+            "matte" => Material::Matte {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
+                sigma: t.float_param(p, "sigma", 0.0)?,
+            },
+            "plastic" => Material::Plastic {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
+                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
+                roughness: t.float_param(p, "roughness", 0.1)?,
+                remap_roughness: remap(p)?,
+            },
+            "mirror" => Material::Mirror {
+                kr: t.spectrum_param(p, "Kr", Spectrum::splat(0.9))?,
+            },
+            "glass" => {
+                let eta = match t.float_param_opt(p, "eta")? {
+                    Some(e) => e,
+                    None => t.float_param(p, "index", 1.5)?,
+                };
+                Material::Glass {
+                    kr: t.spectrum_param(p, "Kr", Spectrum::ONE)?,
+                    kt: t.spectrum_param(p, "Kt", Spectrum::ONE)?,
+                    eta,
+                    u_roughness: t.float_param(p, "uroughness", 0.0)?,
+                    v_roughness: t.float_param(p, "vroughness", 0.0)?,
+                    remap_roughness: remap(p)?,
+                }
+            }
+            "metal" => Material::Metal {
+                eta: t.spectrum_param(p, "eta", COPPER_ETA)?,
+                k: t.spectrum_param(p, "k", COPPER_K)?,
+                roughness: t.float_param(p, "roughness", 0.01)?,
+                u_roughness: t.float_param_opt(p, "uroughness")?,
+                v_roughness: t.float_param_opt(p, "vroughness")?,
+                remap_roughness: remap(p)?,
+            },
+            "uber" => {
+                let eta = match t.float_param_opt(p, "eta")? {
+                    Some(e) => e,
+                    None => t.float_param(p, "index", 1.5)?,
+                };
+                Material::Uber {
+                    kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
+                    ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
+                    kr: t.spectrum_param(p, "Kr", Spectrum::ZERO)?,
+                    kt: t.spectrum_param(p, "Kt", Spectrum::ZERO)?,
+                    roughness: t.float_param(p, "roughness", 0.1)?,
+                    u_roughness: t.float_param_opt(p, "uroughness")?,
+                    v_roughness: t.float_param_opt(p, "vroughness")?,
+                    eta,
+                    opacity: t.spectrum_param(p, "opacity", Spectrum::ONE)?,
+                    remap_roughness: remap(p)?,
+                }
+            }
+            "substrate" => Material::Substrate {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
+                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.5))?,
+                u_roughness: t.float_param(p, "uroughness", 0.1)?,
+                v_roughness: t.float_param(p, "vroughness", 0.1)?,
+                remap_roughness: remap(p)?,
+            },
+            "translucent" => Material::Translucent {
+                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
+                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
+                reflect: t.spectrum_param(p, "reflect", Spectrum::splat(0.5))?,
+                transmit: t.spectrum_param(p, "transmit", Spectrum::splat(0.5))?,
+                roughness: t.float_param(p, "roughness", 0.1)?,
+                remap_roughness: remap(p)?,
+            },
+            "hair" => Material::Hair(crate::hair::HairMaterial::from_params(t, p, loc)?),
+            "fourier" => {
+                let Some(name) = p.string("bsdffile")? else {
+                    return Err(Error::at(loc, "fourier material needs \"string bsdffile\""));
+                };
+                let at = p.get("bsdffile").map_or(loc, |x| &x.loc).clone();
+                let path = t.resolve_file(name, &at);
+                let table = crate::fourier::FourierTable::load(&path)
+                    .map_err(|e| Error::at(&at, format!("fourier material: {e}")))?;
+                Material::Fourier(crate::fourier::FourierBsdf { table })
+            }
+            "disney" => Material::Disney(Box::new(crate::disney::DisneyMaterial::from_params(
+                t, p, loc,
+            )?)),
+            "mix" => {
+                let amount = t.spectrum_param(p, "amount", Spectrum::splat(0.5))?;
+                let Some([a, b]) = md.mix else {
+                    return Err(Error::at(
+                        loc,
+                        "mix material needs \"string namedmaterial1\" and \"namedmaterial2\"",
+                    ));
+                };
+                Material::Mix {
+                    amount,
+                    materials: [self.build(a)?, self.build(b)?],
+                }
+            }
+            k if INTERFACE_KINDS.contains(&k) => Material::Interface,
+            k if UNSUPPORTED_KINDS.contains(&k) => {
+                t.warn_once(
+                    format!("material {k}"),
+                    loc,
+                    format!("material \"{k}\" is not supported; a matte with its Kd is used"),
+                );
+                Material::Matte {
+                    kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
+                    sigma: Texture::Constant(0.0),
+                }
+            }
+            other => return Err(unknown_kind(other, loc)),
+        })
+    }
+}
+
+fn unknown_kind(kind: &str, loc: &acr_parser::Loc) -> Error {
+    let hint = acr_parser::closest(kind, KINDS.iter().chain(&UNSUPPORTED_KINDS).copied())
+        .map_or(String::new(), |k| format!(" (did you mean \"{k}\"?)"));
+    Error::at(loc, format!("unknown material \"{kind}\"{hint}"))
+}
+
+/// Which materials shapes use, directly or through mix materials.
+pub(super) fn used_materials(desc: &SceneDescription) -> Vec<bool> {
+    let n = desc.materials.len();
+    let mut used = vec![false; n];
+    let mut stack: Vec<usize> = desc
+        .shapes
+        .iter()
+        .chain(desc.objects.values().flat_map(|o| o.shapes.iter()))
+        .filter_map(|s| s.material)
+        .collect();
+    while let Some(i) = stack.pop() {
+        if i >= n || used[i] {
+            continue;
+        }
+        used[i] = true;
+        if let Some(pair) = desc.materials[i].mix {
+            stack.extend(pair);
+        }
+    }
+    used
+}
+
+/// Builds `desc.materials` (index i is `desc.materials[i]`). Materials no shape uses (directly
+/// or through a mix) are not built: they get pbrt's default matte, their parameters are marked
+/// used, and their textures are never read. Every material's type is checked: an unknown type
+/// is an error at its location. Warnings (unsupported parameters or types, each once) are
+/// appended to `warnings`. `main_dir` is the main scene file's directory, where file names
+/// that are not next to the file naming them are looked for.
+pub fn build_materials(
+    desc: &SceneDescription,
+    main_dir: &Path,
+    render_from_world: glam::DMat4,
+    warnings: &mut Vec<Warning>,
+) -> Result<Vec<Material>> {
+    for md in &desc.materials {
+        let k = md.plugin.kind.as_str();
+        if !(KINDS.contains(&k) || UNSUPPORTED_KINDS.contains(&k) || INTERFACE_KINDS.contains(&k)) {
+            return Err(unknown_kind(k, &md.plugin.loc));
+        }
+    }
+    let used = used_materials(desc);
+    let n = desc.materials.len();
+    let mut b = MaterialBuilder {
+        desc,
+        textures: TextureBuilder::new(desc, main_dir).with_render_from_world(render_from_world),
+        built: vec![None; n],
+        in_progress: vec![false; n],
+    };
+    let mut out = Vec::with_capacity(n);
+    for (i, md) in desc.materials.iter().enumerate() {
+        if used[i] {
+            out.push((*b.build(i)?).clone());
+        } else {
+            for p in md.plugin.params.iter() {
+                p.mark_used();
+            }
+            out.push(Material::default_matte());
+        }
+    }
+    warnings.extend(b.textures.finish());
+    Ok(out)
+}
