@@ -228,49 +228,31 @@ impl Film {
         let (lo, hi) = (first.0.y.floor() - 0.5 - ry, last.0.y.floor() + 0.5 + ry);
         let w = self.settings.size().0 as usize;
         let splat = &self.splat;
+        let rows = RowSplat {
+            width: w,
+            first_row: cy0,
+            reach: (lo, hi),
+            radius: ry,
+        };
         if splat.prepare_pays() {
             samples
                 .par_iter()
                 .map(|&(p, l)| splat.prepare(p, l))
                 .collect_into_vec(&mut self.prepared);
-            let prepared = &self.prepared;
-            self.sums
-                .par_chunks_mut(w)
-                .enumerate()
-                .for_each(|(row_index, row)| {
-                    let y = row_index as i64 + cy0;
-                    let yf = y as f32;
-                    if yf < lo || yf > hi {
-                        return;
-                    }
-                    // As below.
-                    let (top, bottom) = ((yf + 0.5 - ry).floor(), (yf + 0.5 + ry).floor());
-                    let from = prepared.partition_point(|s| s.p.y.floor() < top);
-                    let to = prepared.partition_point(|s| s.p.y.floor() <= bottom);
-                    for s in &prepared[from..to] {
-                        splat.row_prepared(row, y, s);
-                    }
-                });
-            return;
+            rows.splat(
+                &mut self.sums,
+                &self.prepared,
+                |s| s.p.y,
+                |row, y, s| splat.row_prepared(row, y, s),
+            );
+        } else {
+            rows.splat(
+                &mut self.sums,
+                samples,
+                |&(p, _)| p.y,
+                |row, y, &(p, l)| splat.row(row, y, p, l),
+            );
         }
-        self.sums
-            .par_chunks_mut(w)
-            .enumerate()
-            .for_each(|(row_index, row)| {
-                let y = row_index as i64 + cy0;
-                let yf = y as f32;
-                if yf < lo || yf > hi {
-                    return;
-                }
-                // A superset, by whole raster rows (monotone in the sorted samples), of the
-                // samples whose filter reaches row y (|y - (p.y - 0.5)| <= ry).
-                let (top, bottom) = ((yf + 0.5 - ry).floor(), (yf + 0.5 + ry).floor());
-                let from = samples.partition_point(|(p, _)| p.y.floor() < top);
-                let to = samples.partition_point(|(p, _)| p.y.floor() <= bottom);
-                for &(p, l) in &samples[from..to] {
-                    splat.row(row, y, p, l);
-                }
-            });
     }
 
     /// Adds row-sorted samples to the statistics of the pixels they lie in, rows in parallel.
@@ -345,6 +327,51 @@ impl Film {
                 }
             })
             .collect()
+    }
+}
+
+/// Where [`Film::add_samples`] splats a batch: the film's rows, `width` pixels each, the first
+/// at raster row `first_row`; the rows the batch can reach (`reach`, raster y); the filter's
+/// radius in y.
+struct RowSplat {
+    width: usize,
+    first_row: i64,
+    reach: (f32, f32),
+    radius: f32,
+}
+
+impl RowSplat {
+    /// Splats `items`, sorted by raster row (`floor(y_of)`), into the rows of `sums` in
+    /// parallel: each row takes, in order, the items whose filter may reach it (`put`).
+    fn splat<T: Sync>(
+        &self,
+        sums: &mut [[f64; 4]],
+        items: &[T],
+        y_of: impl Fn(&T) -> f32 + Sync,
+        put: impl Fn(&mut [[f64; 4]], i64, &T) + Sync,
+    ) {
+        use rayon::prelude::*;
+        let (lo, hi) = self.reach;
+        sums.par_chunks_mut(self.width)
+            .enumerate()
+            .for_each(|(row_index, row)| {
+                let y = row_index as i64 + self.first_row;
+                let yf = y as f32;
+                if yf < lo || yf > hi {
+                    return;
+                }
+                // A superset, by whole raster rows (monotone in the sorted items), of the items
+                // whose filter reaches row y (|y - (p.y - 0.5)| <= radius).
+                let (top, bottom) = (
+                    (yf + 0.5 - self.radius).floor(),
+                    (yf + 0.5 + self.radius).floor(),
+                );
+                let from = items.partition_point(|t| y_of(t).floor() < top);
+                let to = items.partition_point(|t| y_of(t).floor() <= bottom);
+                for t in &items[from..to] {
+                    put(row, y, t);
+                }
+            });
     }
 }
 
