@@ -313,6 +313,27 @@ fn equal_time_spp(spp: u32, baseline: Option<f64>, own: Option<f64>) -> u32 {
     }
 }
 
+/// A compared run's spp and time limit: at equal spp the budget; at equal time the first
+/// method's seconds at this budget as the limit (`seconds.0`, an error where it failed) with the
+/// spp that `time_limited_spp` names or the method's own equal-spp seconds (`seconds.1`) say fit.
+fn run_budget(
+    mode: Mode,
+    spp: u32,
+    budgets: &Budgets,
+    seconds: (Option<f64>, Option<f64>),
+) -> Result<(u32, Option<f64>), String> {
+    match (mode, seconds) {
+        (Mode::EqualSpp, _) => Ok((spp, None)),
+        (Mode::EqualTime, (None, _)) => Err("the first method failed at this budget".to_owned()),
+        (Mode::EqualTime, (Some(baseline), own)) => Ok((
+            budgets
+                .time_limited_spp
+                .unwrap_or_else(|| equal_time_spp(spp, Some(baseline), own)),
+            Some(baseline),
+        )),
+    }
+}
+
 /// Runs the whole manifest; returns what it measured (failed runs included).
 pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResults, String> {
     let m = read_manifest(manifest_path)?;
@@ -368,34 +389,21 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
                             file_safe(&method.label),
                             mode.name()
                         ));
-                        let outcome = match (&reference, mode, baseline_seconds[i]) {
-                            (Err(e), _, _) => Err(e.clone()),
-                            (Ok(_), Mode::EqualTime, None) => {
-                                Err("the first method failed at this budget".to_owned())
-                            }
-                            (Ok(reference), _, baseline) => {
-                                let (run_spp, limit) = match mode {
-                                    Mode::EqualSpp => (spp, None),
-                                    Mode::EqualTime => (
-                                        m.budgets.time_limited_spp.unwrap_or_else(|| {
-                                            equal_time_spp(spp, baseline, own_seconds[i])
-                                        }),
-                                        baseline,
-                                    ),
-                                };
-                                measure(
-                                    opts,
-                                    &scene_path,
-                                    &out,
-                                    method,
-                                    run_spp,
-                                    seed,
-                                    m.threads,
-                                    limit,
-                                    reference,
-                                )
-                            }
-                        };
+                        let outcome = reference.as_ref().map_err(Clone::clone).and_then(|r| {
+                            let budget = (baseline_seconds[i], own_seconds[i]);
+                            let (run_spp, limit) = run_budget(mode, spp, &m.budgets, budget)?;
+                            measure(
+                                opts,
+                                &scene_path,
+                                &out,
+                                method,
+                                run_spp,
+                                seed,
+                                m.threads,
+                                limit,
+                                r,
+                            )
+                        });
                         if k == 0 {
                             baseline_seconds[i] = outcome.as_ref().ok().map(|r| r.seconds);
                         }
@@ -688,6 +696,27 @@ mod tests {
     }
 
     use super::*;
+
+    #[test]
+    fn a_compared_run_takes_its_budget_or_the_first_method_s_time() {
+        let mut budgets = Budgets {
+            spp: vec![8],
+            equal_time: true,
+            time_limited_spp: None,
+        };
+        let run = |mode, seconds, b: &Budgets| run_budget(mode, 8, b, seconds);
+        assert_eq!(
+            run(Mode::EqualSpp, (Some(1.0), None), &budgets),
+            Ok((8, None))
+        );
+        // Twice as slow as the first method: half the spp, in its time.
+        let half = (Some(1.0), Some(2.0));
+        assert_eq!(run(Mode::EqualTime, half, &budgets), Ok((4, Some(1.0))));
+        assert!(run(Mode::EqualTime, (None, Some(2.0)), &budgets)
+            .is_err_and(|e| e.contains("first method failed")));
+        budgets.time_limited_spp = Some(64);
+        assert_eq!(run(Mode::EqualTime, half, &budgets), Ok((64, Some(1.0))));
+    }
 
     #[test]
     fn manifest_errors_are_located() {
