@@ -13,6 +13,12 @@ each pixel's mean, per channel), written as PFM:
     python3 bench/tools/oracle_allocation.py S-var.pfm 256 8:2 16:4
 
 Each budget is `spp:floor` (the floor is the uniform first stage every pixel gets).
+`--counts=N.pfm` also scores a sampler's own placement, its `--aov spp` image, the same way:
+
+    acr render scenes/S.pbrt --spp 8 --seed 1 --threads 2 --sampler cluster \
+        --filter gaussian -o S8.exr --aov spp=N.pfm
+    python3 bench/tools/oracle_allocation.py S-var.pfm 256 8:2 --counts=N.pfm
+
 Needs numpy.
 """
 
@@ -48,17 +54,31 @@ def oracle_ratio(sigma, spp, floor):
     return float(err.sum() / ((sigma**2).sum() / spp))
 
 
+def placement_ratio(sigma, counts):
+    """The MSE of the pixel means with `counts` samples each over a uniform placement's."""
+    spp = counts.mean()
+    err = np.divide(sigma**2, counts, out=np.zeros_like(sigma), where=sigma > 0)
+    return float(err.sum() / ((sigma**2).sum() / spp))
+
+
 def main():
-    if len(sys.argv) < 4:
+    counts = [a.split("=", 1)[1] for a in sys.argv[1:] if a.startswith("--counts=")]
+    args = [a for a in sys.argv[1:] if not a.startswith("--counts=")]
+    if len(args) < 3 and not (len(args) == 2 and counts):
         sys.exit(__doc__)
-    variance, rendered_spp = sys.argv[1], float(sys.argv[2])
+    variance, rendered_spp = args[0], float(args[1])
     # Per-sample variance: the pixel mean's variance times its count, channels averaged.
     per_sample = read_pfm(variance).mean(axis=2) * rendered_spp
     sigma = np.sqrt(np.maximum(per_sample, 0.0)).ravel()
     print(f"{variance}: {np.mean(sigma == 0) * 100:.1f}% of pixels without variance")
-    for budget in sys.argv[3:]:
+    for budget in args[2:]:
         spp, floor = (float(x) for x in budget.split(":"))
         print(f"  {spp:g} spp, first stage {floor:g}: {oracle_ratio(sigma, spp, floor):.3f}")
+    for path in counts:
+        n = read_pfm(path)[..., 0].ravel().astype(np.float64)
+        if n.shape != sigma.shape:
+            sys.exit(f"{path}: {n.size} pixels, the variances {sigma.size}")
+        print(f"  {path} ({n.mean():g} spp): {placement_ratio(sigma, n):.3f}")
 
 
 if __name__ == "__main__":
