@@ -78,7 +78,8 @@ def main():
         n = read_pfm(path)[..., 0].ravel().astype(np.float64)
         if n.shape != sigma.shape:
             sys.exit(f"{path}: {n.size} pixels, the variances {sigma.size}")
-        print(f"  {path} ({n.mean():g} spp): {placement_ratio(sigma, n):.3f}")
+        corr = np.corrcoef(n, sigma)[0, 1]
+        print(f"  {path} ({n.mean():g} spp): {placement_ratio(sigma, n):.3f}, counts ~ sigma {corr:.2f}")
 
 
 if __name__ == "__main__":
