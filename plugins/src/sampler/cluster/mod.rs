@@ -59,10 +59,20 @@ struct Round {
     /// Its points' cells and in-cell offsets, in batch order: kept only by a sampler that
     /// learns its own rounds' values (see [`ClusterSampler::learns_own_rounds`]).
     cells: Vec<(u32, [f32; MAX_DIMS])>,
-    /// The clusters it sampled.
-    clusters: Vec<u32>,
-    /// Their queue entries as picked (for [`ClusterSampler::requeue_picked`]).
+    /// The queue entries of the clusters it sampled, as picked, in order.
     picked: Vec<Queued>,
+    /// Room for their ids, which the update after the round lists (reused).
+    ids: Vec<u32>,
+}
+
+impl Round {
+    /// The ids of the clusters it sampled, in the order picked, in its reused buffer.
+    fn picked_ids(&mut self) -> Vec<u32> {
+        let mut ids = std::mem::take(&mut self.ids);
+        ids.clear();
+        ids.extend(self.picked.iter().map(|e| e.id));
+        ids
+    }
 }
 
 /// The adaptive cluster sampler.
@@ -268,8 +278,8 @@ impl ClusterSampler {
             .min(self.remaining);
         let Round {
             cells,
-            mut clusters,
             mut picked,
+            ids,
             ..
         } = self.spare.pop().unwrap_or_default();
         picked.clear();
@@ -349,13 +359,11 @@ impl ClusterSampler {
             let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
             self.draw_cells(&picks, &mut rng, out);
         }
-        clusters.clear();
-        clusters.extend(picks.iter().map(|&(id, _)| id));
         self.in_flight.push_back(Round {
             points: out.len(),
             cells: std::mem::take(&mut self.round_cells),
-            clusters,
             picked,
+            ids,
         });
         self.remaining -= planned_total;
         self.given_adaptive += planned_total;
@@ -480,32 +488,22 @@ impl Sampler for ClusterSampler {
             Some(r) if r.points == batch.len() => self.in_flight.pop_front(),
             _ => None,
         };
-        let Some(Round {
-            points,
-            cells,
-            clusters,
-            picked,
-        }) = round
-        else {
+        let Some(mut round) = round else {
             self.grid.locate_all(batch, &mut self.round_cells);
             self.sums.add_batch(&self.round_cells, radiance, None);
             return;
         };
         // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
-        self.sums.add_batch(&cells, radiance, None);
-        for (&(cell, _), l) in cells.iter().zip(radiance) {
+        self.sums.add_batch(&round.cells, radiance, None);
+        for (&(cell, _), l) in round.cells.iter().zip(radiance) {
             if !l[0].is_nan() {
                 self.touched[cell as usize / 64] |= 1 << (cell % 64);
             }
         }
         // A round is one batch: update now.
-        let clusters = self.update(clusters);
-        self.spare.push(Round {
-            points,
-            cells,
-            clusters,
-            picked,
-        });
+        let ids = round.picked_ids();
+        round.ids = self.update(ids);
+        self.spare.push(round);
         if self.phase == Phase::Done {
             self.finish();
         }
@@ -536,11 +534,12 @@ impl Sampler for ClusterSampler {
             _ => None,
         };
         if let Some(mut round) = round {
-            round.clusters = if self.settings.colour.is_some() {
+            let ids = round.picked_ids();
+            round.ids = if self.settings.colour.is_some() {
                 // A half of an unbiased pair learns nothing after its first stage.
-                self.requeue_picked(&mut round.picked, round.clusters)
+                self.requeue_picked(&mut round.picked, ids)
             } else {
-                self.update(round.clusters)
+                self.update(ids)
             };
             self.spare.push(round);
         }
