@@ -56,10 +56,10 @@ impl PixelCursor {
     /// The next batch: row-major pixel indices and the sample indices each of them gets, or
     /// None when every pixel is done.
     pub(crate) fn next(&mut self) -> Option<(Range<u64>, Range<u32>)> {
-        let total = self.space.pixels();
-        if total == 0 || self.pass_start >= self.spp {
+        if !self.has_next() {
             return None;
         }
+        let total = self.space.pixels();
         let n = self.pass_len.min(self.spp - self.pass_start);
         // A pixel with more than a batch's samples forms a batch alone.
         let per_batch = (BATCH_SAMPLES / u64::from(n)).max(1);
