@@ -1,0 +1,121 @@
+//! Image maps: converted texels with pbrt-v3's wrap modes and bilinear lookup.
+
+use super::value::TexValue;
+use crate::geometry::{Spectrum, Vec2};
+use crate::image_io::RgbImage;
+use std::fmt::Debug;
+
+/// What an image lookup outside [0, 1]² gives (pbrt-v3's `ImageWrap`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    /// Tile the image.
+    Repeat,
+    /// Black outside.
+    Black,
+    /// The nearest edge texel.
+    Clamp,
+}
+
+/// An image ready for lookups: texels already converted (gamma, scale, invert), bottom row
+/// first, so that t = 0 is the bottom of the picture as in pbrt-v3.
+#[derive(Clone, Debug)]
+pub struct ImageMap<T> {
+    width: usize,
+    height: usize,
+    texels: Vec<T>,
+    wrap: Wrap,
+}
+
+impl<T: TexValue> ImageMap<T> {
+    /// From an image (top row first) and the conversion of each texel.
+    pub fn new(img: &RgbImage, wrap: Wrap, convert: impl Fn(Spectrum) -> T) -> Self {
+        let (width, height) = (img.width.max(1), img.height.max(1));
+        let mut texels = Vec::with_capacity(width * height);
+        for t in 0..height {
+            for s in 0..width {
+                let c = if img.width == 0 || img.height == 0 {
+                    Spectrum::ZERO
+                } else {
+                    img.get(s, img.height - 1 - t)
+                };
+                texels.push(convert(c));
+            }
+        }
+        Self {
+            width,
+            height,
+            texels,
+            wrap,
+        }
+    }
+
+    /// From texels already in lookup order (row 0 at t = 0), `width` x `height` of them.
+    pub fn from_rows(width: usize, height: usize, texels: Vec<T>, wrap: Wrap) -> Self {
+        debug_assert_eq!(texels.len(), width * height);
+        Self {
+            width,
+            height,
+            texels,
+            wrap,
+        }
+    }
+
+    /// What a lookup outside [0, 1]² gives.
+    pub fn wrap(&self) -> Wrap {
+        self.wrap
+    }
+
+    /// The texels, row 0 first.
+    pub fn texels(&self) -> &[T] {
+        &self.texels
+    }
+
+    /// Width in texels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in texels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The texel at column `s`, row `t` counted from the bottom, wrapped.
+    #[inline]
+    pub fn texel(&self, s: i64, t: i64) -> T {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let (s, t) = match self.wrap {
+            Wrap::Repeat => (s.rem_euclid(w), t.rem_euclid(h)),
+            Wrap::Clamp => (s.clamp(0, w - 1), t.clamp(0, h - 1)),
+            Wrap::Black => {
+                if s < 0 || s >= w || t < 0 || t >= h {
+                    return T::ZERO;
+                }
+                (s, t)
+            }
+        };
+        self.texels[t as usize * self.width + s as usize]
+    }
+
+    /// Bilinear interpolation at (s, t) in [0, 1]² (pbrt-v3's `MIPMap::triangle` at level 0).
+    #[inline]
+    pub fn bilerp(&self, st: Vec2) -> T {
+        // Keep the integer arithmetic far from overflow; NaN becomes 0.
+        let fix = |v: f32| {
+            if v.is_finite() {
+                v.clamp(-1e9, 1e9)
+            } else {
+                0.0
+            }
+        };
+        let s = fix(st.x * self.width as f32 - 0.5);
+        let t = fix(st.y * self.height as f32 - 0.5);
+        let (s0, t0) = (s.floor(), t.floor());
+        let (ds, dt) = (s - s0, t - t0);
+        let (s0, t0) = (s0 as i64, t0 as i64);
+        self.texel(s0, t0) * ((1.0 - ds) * (1.0 - dt))
+            + self.texel(s0, t0 + 1) * ((1.0 - ds) * dt)
+            + self.texel(s0 + 1, t0) * (ds * (1.0 - dt))
+            + self.texel(s0 + 1, t0 + 1) * (ds * dt)
+    }
+}
