@@ -18,7 +18,6 @@ pub mod image_io;
 pub mod integrator;
 pub mod interpolation;
 pub mod light;
-pub mod light_image;
 pub mod lightbvh;
 pub mod lightdistrib;
 pub mod material;

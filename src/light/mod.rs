@@ -600,12 +600,7 @@ pub fn spot_frame(dir: Vec3) -> Mat4 {
 /// (already scaled for the direction): intensity / distance², pdf 1; `None` when it sends
 /// nothing that way.
 #[inline]
-fn delta_sample(
-    pos: Vec3,
-    p: Vec3,
-    wi: Vec3,
-    intensity: Spectrum,
-) -> Option<LightSample> {
+fn delta_sample(pos: Vec3, p: Vec3, wi: Vec3, intensity: Spectrum) -> Option<LightSample> {
     if intensity == Spectrum::ZERO {
         return None;
     }
