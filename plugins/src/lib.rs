@@ -2,7 +2,7 @@
 //! filters, over the abstract rendering space. Nothing here knows about geometry, so every
 //! plugin is testable on analytic integrands.
 
-pub mod cluster;
+pub mod cells;
 pub mod color;
 pub mod film;
 pub mod filters;

@@ -8,20 +8,20 @@
 //!
 //! With `features` on, the film keeps first-hit features in its own cells (one per pixel)
 //! whatever the sampler, the fit's clusters are merged by noise where the features agree too
-//! (`cluster/by_noise.rs`), and each cluster's model has a linear term per feature
+//! (`cells/by_noise.rs`), and each cluster's model has a linear term per feature
 //! (`regression.rs`).
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
-use crate::cluster::build::{initial_clustering, Initial};
-use crate::cluster::by_noise::{grow_by_noise_with, NoiseClusters};
-use crate::cluster::grid::MAX_DIMS;
-use crate::cluster::{CellGrid, CellSums, CellView};
+use crate::cells::build::{initial_clustering, Initial};
+use crate::cells::by_noise::{grow_by_noise_with, NoiseClusters};
+use crate::cells::grid::MAX_DIMS;
+use crate::cells::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
 use crate::first_hit::Features;
 use crate::partition::Partition;
+use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
 use crate::prefilter::prefilter_features;
 use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
-use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
 use crate::sampler::ClusterSettings;
 use acr_parser::{ParamType, Result};
 use rayon::prelude::*;

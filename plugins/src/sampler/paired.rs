@@ -16,7 +16,7 @@
 use super::{
     alternate, pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, SamplerSetup,
 };
-use crate::cluster::CellView;
+use crate::cells::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
 use crate::registry::{error_at_param, float_in, int_in, Choice, ParamSpec};

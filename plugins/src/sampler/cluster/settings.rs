@@ -2,7 +2,7 @@
 //! and the parsing of a scene's or the command line's values.
 
 use super::ClusterSampler;
-use crate::cluster::build::ClusterParams;
+use crate::cells::build::ClusterParams;
 use crate::registry::{
     error_at_param, float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo,
 };
