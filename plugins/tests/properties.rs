@@ -4,7 +4,7 @@
 //! of its cell means where it clamps.
 
 use acr_plugins::cells::grid::MAX_DIMS;
-use acr_plugins::regression::{Fit, FitCell, FitSettings};
+use acr_plugins::polynomial_fit::{Fit, FitCell, FitSettings};
 use acr_plugins::space::{Dims, RenderingSpace};
 use acr_plugins::SAMPLERS;
 use proptest::prelude::*;

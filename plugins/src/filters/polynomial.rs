@@ -1,5 +1,5 @@
 //! `polynomial`: the paper's reconstruction (ALGORITHM.md section 5). Each cluster of cells is
-//! fitted with one additive Legendre polynomial over the active dims (`crate::regression`),
+//! fitted with one additive Legendre polynomial over the active dims (`crate::polynomial_fit`),
 //! and a pixel is the integral of the models over the cells it covers: for each cell, the
 //! share of the pixel's volume it covers times its cluster's mean over the overlap. After the
 //! cluster sampler it uses that sampler's cells and clusters; after any other sampler the film
@@ -9,7 +9,7 @@
 //! With `features` on, the film keeps first-hit features in its own cells (one per pixel)
 //! whatever the sampler, the fit's clusters are merged by noise where the features agree too
 //! (`cells/by_noise.rs`), and each cluster's model has a linear term per feature
-//! (`regression.rs`).
+//! (`polynomial_fit.rs`).
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, FilterReport, SamplerOutput};
 use crate::cells::build::{initial_clustering, Initial};
@@ -19,7 +19,7 @@ use crate::cells::{CellGrid, CellSums, CellView};
 use crate::film::{Film, Spectrum};
 use crate::first_hit::Features;
 use crate::partition::Partition;
-use crate::regression::{Fit, FitCell, FitSettings, MAX_DEGREE};
+use crate::polynomial_fit::{Fit, FitCell, FitSettings, MAX_DEGREE};
 use crate::prefilter::prefilter_features;
 use crate::registry::{float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::sampler::ClusterSettings;
