@@ -9,7 +9,7 @@ pub mod camera;
 pub mod cli;
 pub mod disney;
 pub mod exr_channels;
-pub mod features;
+pub mod first_hit;
 pub mod fourier;
 pub use acr_plugins::film;
 pub mod geometry;
