@@ -647,7 +647,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "pixels one unit of time or lens counts as when choosing the longest axis",
             ),
             super::paired::STREAMS,
-            super::paired::PILOT,
+            super::paired::PILOT_ONLY,
         ],
     },
     build: build_streams,
