@@ -1,4 +1,4 @@
-//! The cell features: the feature vector F = (g, s, p) of a cell (ALGORITHM.md section 3, paper
+//! The cell features: the feature vector F = (g, s, p) of a cell (docs/algorithm.md §3, paper
 //! eq. 2-9), by which cells cluster. Not the first-hit features (albedo, normal, depth) of
 //! [`crate::first_hit`].
 

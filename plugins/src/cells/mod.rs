@@ -1,4 +1,4 @@
-//! The cells of the rendering space and their clustering (ALGORITHM.md sections 2 to 4): the
+//! The cells of the rendering space and their clustering (docs/algorithm.md §2 to §4): the
 //! cell grid and its running sums, the feature vector of each cell ([`cell_features`]), clusters
 //! of cells and the queue of clusters to sample. The cluster sampler (`sampler/cluster/`)
 //! drives it; a reconstruction that needs clusters builds them with the same code.
