@@ -6,7 +6,7 @@
 //! for emission it hits (as pbrt-v4 does), where pbrt-v3 traces a separate ray for it. Same
 //! expectation, one ray fewer per bounce.
 
-use crate::features::{FirstHit, FirstHitProbe};
+use crate::first_hit::{FirstHit, FirstHitProbe};
 use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;

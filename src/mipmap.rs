@@ -5,7 +5,8 @@
 //! default or trilinear on request. Without a footprint (rays after the first bounce) a lookup
 //! is bilinear in the first level, as pbrt-v3's.
 
-use crate::texture::{ImageMap, TexValue, Wrap};
+use crate::texture::image_map::{ImageMap, Wrap};
+use crate::texture::value::TexValue;
 use glam::Vec2;
 
 /// Entries of pbrt-v3's Gaussian weight table.

@@ -5,7 +5,7 @@
 use crate::geometry::Spectrum;
 use crate::integrator::{Integrator, IntegratorBuild, INTEGRATORS};
 use acr_parser::{Result, SceneDescription, Warning};
-use acr_plugins::cluster::CellGrid;
+use acr_plugins::cells::CellGrid;
 use acr_plugins::filters::{FilterBuild, SamplerOutput};
 use acr_plugins::registry::{check_params, lookup};
 use acr_plugins::sampler::SamplerBuild;

@@ -2,7 +2,7 @@
 //! added to the film in a fixed order, so the image depends on the scene, seed and budget only.
 
 use crate::camera::CameraSample;
-use crate::features::{FeatureImage, FirstHit};
+use crate::first_hit::{FeatureImage, FirstHit};
 use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
 use crate::geometry::{Ray, RayDifferentials};
 use crate::integrator::{Integrator, Radiance};

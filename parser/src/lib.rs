@@ -9,20 +9,24 @@ pub mod lexer;
 pub mod mesh;
 pub mod params;
 pub mod parser;
+pub mod paths;
 pub mod ply;
 pub mod scene;
 pub mod source;
+pub mod suggest;
 pub mod transform;
 
 pub use error::{Error, Result, Warning};
 pub use mesh::Mesh;
 pub use params::{Param, ParamList, ParamType, TextureRef, Values};
-pub use parser::{closest, io_message, parse_file, parse_str, resolve_path};
+pub use parser::{parse_file, parse_str};
+pub use paths::{io_message, resolve_path};
 pub use scene::{
     CameraDesc, InstanceDesc, LightDesc, MaterialDesc, ObjectDesc, PluginDesc, SceneDescription,
     ShapeDesc, TextureDesc, TextureValue,
 };
 pub use source::{Loc, SourceFile};
+pub use suggest::closest;
 pub use transform::AnimatedTransform;
 
 /// A number for the scene dump: short, stable, and free of floating-point dust.

@@ -5,8 +5,10 @@ use crate::builder::Builder;
 use crate::error::{Error, Result};
 use crate::lexer::{Token, TokenKind, Tokenizer};
 use crate::params::{Param, ParamList, ParamType, TextureRef, Values};
+use crate::paths::{io_message, resolve_path};
 use crate::scene::SceneDescription;
 use crate::source::{Loc, SourceFile};
+use crate::suggest::did_you_mean;
 use glam::{DMat4, DVec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -93,60 +95,6 @@ fn decode_text(path: &Path, bytes: Vec<u8>) -> Result<String> {
         let file = SourceFile::new(path, String::from_utf8_lossy(&bytes).into_owned());
         Error::at(&Loc::new(&file, at), message)
     })
-}
-
-/// An I/O error in words, without Rust's "(os error 2)" suffix.
-pub fn io_message(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".to_owned(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".to_owned(),
-        _ => {
-            let s = e.to_string();
-            match s.find(" (os error") {
-                Some(i) => s[..i].to_owned(),
-                None => s,
-            }
-        }
-    }
-}
-
-/// Resolves a file name written in a scene: relative to the file that names it, and failing
-/// that relative to the main scene file's directory (pbrt-v3's rule), so both layouts work.
-pub fn resolve_path(name: &str, including: &SourceFile, base_dir: &Path) -> PathBuf {
-    let p = Path::new(name);
-    if p.is_absolute() {
-        return p.to_path_buf();
-    }
-    let local = including.dir().join(p);
-    if local.exists() {
-        return local;
-    }
-    let from_base = base_dir.join(p);
-    if from_base.exists() {
-        from_base
-    } else {
-        local
-    }
-}
-
-/// The closest of `known` to `name`, if close enough to be a likely misspelling.
-pub fn closest<'a>(name: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    known
-        .into_iter()
-        .map(|k| {
-            (
-                strsim::damerau_levenshtein(&name.to_lowercase(), &k.to_lowercase()),
-                k,
-            )
-        })
-        .filter(|&(d, k)| d <= 2.max(k.len() / 3))
-        .min_by_key(|&(d, _)| d)
-        .map(|(_, k)| k)
-}
-
-/// " (did you mean X?)" or nothing.
-pub(crate) fn did_you_mean<'a>(name: &str, known: impl IntoIterator<Item = &'a str>) -> String {
-    closest(name, known).map_or(String::new(), |k| format!(" (did you mean {k}?)"))
 }
 
 fn describe(kind: &TokenKind) -> String {

@@ -2,16 +2,16 @@
 //! filters, over the abstract rendering space. Nothing here knows about geometry, so every
 //! plugin is testable on analytic integrands.
 
-pub mod cluster;
+pub mod cells;
 pub mod color;
 pub mod film;
 pub mod filters;
 pub mod first_hit;
 pub mod kernel;
 pub mod partition;
+pub mod polynomial_fit;
 pub mod prefilter;
 pub mod registry;
-pub mod regression;
 pub mod rng;
 pub mod sampler;
 pub mod space;

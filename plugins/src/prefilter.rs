@@ -6,7 +6,7 @@
 //! from it by no more than their noise, a noisy feature loses its noise, and a precise one
 //! (its samples agree) keeps its edges.
 
-use crate::cluster::{CellGrid, CellSums};
+use crate::cells::{CellGrid, CellSums};
 use crate::color::{luminance, Spectrum};
 use crate::first_hit::{Features, DEPTH, FEATURES, NORMAL};
 use rayon::prelude::*;

@@ -44,7 +44,7 @@ fn space() -> RenderingSpace {
 }
 
 /// Filter `name` with its defaults; `polynomial` without first-hit features (the paper's fit:
-/// the field here has none; `feature_regression.rs` tests them).
+/// the field here has none; `feature_fit.rs` tests them).
 fn filter(name: &str) -> Box<dyn Filter> {
     let e = FILTERS.iter().find(|e| e.info.name == name).unwrap();
     let mut c = Choice::new(None, name, None);

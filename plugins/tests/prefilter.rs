@@ -2,7 +2,7 @@
 //! albedo, depth or normal with like neighbours, leaves a precise one alone, never crosses a
 //! depth, normal or shading edge, and stays finite on degenerate cells.
 
-use acr_plugins::cluster::{CellGrid, CellSums};
+use acr_plugins::cells::{CellGrid, CellSums};
 use acr_plugins::first_hit::Features;
 use acr_plugins::prefilter::prefilter_features;
 use acr_plugins::rng::mix64;

@@ -3,8 +3,8 @@
 //! however noisy, sparse or extreme its values, is finite, non-negative and within the range
 //! of its cell means where it clamps.
 
-use acr_plugins::cluster::grid::MAX_DIMS;
-use acr_plugins::regression::{Fit, FitCell, FitSettings};
+use acr_plugins::cells::grid::MAX_DIMS;
+use acr_plugins::polynomial_fit::{Fit, FitCell, FitSettings};
 use acr_plugins::space::{Dims, RenderingSpace};
 use acr_plugins::SAMPLERS;
 use proptest::prelude::*;

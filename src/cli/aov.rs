@@ -4,10 +4,10 @@
 //! by the largest value, which is written into the PNG (a tEXt chunk) and printed. `clusters`
 //! is the cluster sampler's final partition: in a PNG each cluster a colour with its borders
 //! drawn dark (the paper's figures 2 and 4), in an EXR each pixel's cluster id. `albedo`,
-//! `normal` and `depth` are the means of each pixel's first-hit features (`features.rs`), linear
+//! `normal` and `depth` are the means of each pixel's first-hit features (`first_hit.rs`), linear
 //! in an EXR or PFM, as Open Image Denoise's tools read them.
 
-use crate::features::FeatureImage;
+use crate::first_hit::FeatureImage;
 use crate::geometry::Spectrum;
 use crate::image_io::{write_image, RgbImage};
 use acr_plugins::{Partition, PixelStats};

@@ -5,7 +5,7 @@
 use crate::cli::aov::AovRequest;
 use crate::cli::mergeable::Sums;
 use crate::exr_channels::{Attribute, Channels};
-use crate::features::FeatureImage;
+use crate::first_hit::FeatureImage;
 use crate::geometry::Spectrum;
 use crate::image_io::{is_exr, write_image_in_frame, Frame, RgbImage};
 use acr_plugins::{Film, PixelStats};

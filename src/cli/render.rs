@@ -6,7 +6,7 @@ use crate::cli::display::Display;
 use crate::cli::output::{reached_spp, End, Output};
 use crate::cli::replay::{Recording, Replay};
 use crate::cli::stats::{median, peak_rss_mb, Seconds, Stats};
-use crate::features::FeatureImage;
+use crate::first_hit::FeatureImage;
 use crate::image_io::Frame;
 use crate::integrator::Integrator;
 use crate::registry::{choose_for_scene, Overrides};

@@ -4,8 +4,8 @@
 use super::Builder;
 use crate::geometry::{Spectrum, Vec3};
 use crate::image_io::RgbImage;
+use crate::light::light_image::LightImage;
 use crate::light::{spot_frame, EnvMap, Light};
-use crate::light_image::LightImage;
 use acr_parser::{Error, ParamList, ParamType, PluginDesc, Result};
 use glam::DMat4;
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! pbrt-v3's cone: radius `radius` at z = 0 narrowing to its apex at z = `height`.
 
+use super::profile::Profile;
 use super::quadric::phi_of;
-use super::revolved::Profile;
 use crate::geometry::{Vec2, Vec3};
 use glam::DVec3;
 

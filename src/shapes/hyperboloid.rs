@@ -1,7 +1,7 @@
 //! pbrt-v3's hyperboloid: the surface swept by the segment p1-p2 turning about the z axis,
 //! a x^2 + a y^2 - c z^2 = 1.
 
-use super::revolved::Profile;
+use super::profile::Profile;
 use crate::geometry::{Vec2, Vec3};
 use glam::DVec3;
 use std::f32::consts::PI;

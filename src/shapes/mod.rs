@@ -13,6 +13,7 @@ pub mod hyperboloid;
 pub mod loopsubdiv;
 pub mod nurbs;
 pub mod paraboloid;
+pub mod profile;
 pub mod quadric;
 pub mod revolved;
 pub mod sphere;

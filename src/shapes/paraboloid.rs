@@ -1,7 +1,7 @@
 //! pbrt-v3's paraboloid: z = zmax (x^2 + y^2) / radius^2, kept for z in [zmin, zmax].
 
+use super::profile::Profile;
 use super::quadric::phi_of;
-use super::revolved::Profile;
 use crate::geometry::{Vec2, Vec3};
 use glam::DVec3;
 

@@ -17,103 +17,24 @@
 use crate::geometry::{Spectrum, SurfaceInteraction};
 use crate::mipmap::MipMap;
 use crate::procedural::{in_dot, NoisePattern};
-use crate::spectrum::{is_spectrum_type, luminance, spectrum_param_to_rgb, srgb_to_linear};
+use crate::spectrum::{is_spectrum_type, spectrum_param_to_rgb};
 use acr_parser::{Error, Loc, Param, ParamList, ParamType, Result, Values};
 use glam::Mat4;
 use std::fmt::Debug;
-use std::ops::{Add, Mul};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 mod builder;
-mod image;
+pub mod image_map;
 mod mapping;
 #[cfg(test)]
 mod tests;
+pub mod value;
 
 pub use builder::TextureBuilder;
-pub use image::{ImageMap, Wrap};
+pub use image_map::{ImageMap, Wrap};
 pub use mapping::Mapping2D;
-
-/// A value a texture can produce: `f32` or [`Spectrum`].
-pub trait TexValue:
-    Copy
-    + Debug
-    + PartialEq
-    + Send
-    + Sync
-    + 'static
-    + Add<Output = Self>
-    + Mul<Output = Self>
-    + Mul<f32, Output = Self>
-{
-    /// Zero.
-    const ZERO: Self;
-    /// One.
-    const ONE: Self;
-    /// pbrt-v3's `uv` texture value at (s, t): (s - ⌊s⌋, t - ⌊t⌋, 0) as a colour; for floats,
-    /// s - ⌊s⌋.
-    fn from_uv(s: f32, t: f32) -> Self;
-    /// A texel of an image file as pbrt-v3's image texture stores it: sRGB-decoded when `gamma`
-    /// (for floats, the luminance is decoded), times `scale`; with `invert`, 1 - v, at least 0.
-    fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self;
-    /// The value with negative parts set to 0.
-    fn clamp_nonneg(self) -> Self;
-}
-
-impl TexValue for f32 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-
-    fn from_uv(s: f32, _t: f32) -> Self {
-        s - s.floor()
-    }
-
-    fn clamp_nonneg(self) -> Self {
-        self.max(0.0)
-    }
-
-    fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self {
-        let y = luminance(rgb);
-        let v = scale * if gamma { srgb_to_linear(y) } else { y };
-        if invert {
-            (1.0 - v).max(0.0)
-        } else {
-            v
-        }
-    }
-}
-
-impl TexValue for Spectrum {
-    const ZERO: Self = Spectrum::ZERO;
-    const ONE: Self = Spectrum::ONE;
-
-    fn from_uv(s: f32, t: f32) -> Self {
-        Spectrum::new(s - s.floor(), t - t.floor(), 0.0)
-    }
-
-    fn clamp_nonneg(self) -> Self {
-        self.max(Spectrum::ZERO)
-    }
-
-    fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self {
-        let c = if gamma {
-            Spectrum::new(
-                srgb_to_linear(rgb.x),
-                srgb_to_linear(rgb.y),
-                srgb_to_linear(rgb.z),
-            )
-        } else {
-            rgb
-        };
-        let v = c * scale;
-        if invert {
-            (Spectrum::ONE - v).max(Spectrum::ZERO)
-        } else {
-            v
-        }
-    }
-}
+pub use value::TexValue;
 
 /// A texture producing `T` (`f32` for [`FloatTexture`], [`Spectrum`] for
 /// [`SpectrumTexture`]). Shared parts are behind `Arc`s, so cloning is cheap.

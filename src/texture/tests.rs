@@ -3,6 +3,7 @@
 use super::*;
 use crate::geometry::{Vec2, Vec3};
 use crate::image_io::RgbImage;
+use crate::spectrum::srgb_to_linear;
 use acr_parser::parse_str;
 use acr_parser::SceneDescription;
 use glam::DMat4;

@@ -3,9 +3,9 @@
 
 use super::{Block, Builder, Phase, Saved};
 use crate::error::{Error, Result};
-use crate::parser::did_you_mean;
 use crate::scene::{InstanceDesc, ObjectDesc};
 use crate::source::Loc;
+use crate::suggest::did_you_mean;
 use glam::DMat4;
 
 impl Builder {

@@ -4,9 +4,9 @@
 use super::Builder;
 use crate::error::{Error, Result};
 use crate::params::{ParamList, Values};
-use crate::parser::did_you_mean;
 use crate::scene::{MaterialDesc, PluginDesc, TextureDesc, TextureValue};
 use crate::source::Loc;
+use crate::suggest::did_you_mean;
 use std::sync::Arc;
 
 impl Builder {

@@ -5,7 +5,7 @@
 use crate::error::{Error, Result, Warning};
 use crate::mesh::Mesh;
 use crate::params::{ParamList, ParamType, Values};
-use crate::parser::{io_message, resolve_path};
+use crate::paths::{io_message, resolve_path};
 use crate::scene::{
     CameraDesc, LightDesc, MaterialDesc, ObjectDesc, PluginDesc, SceneDescription, ShapeDesc,
 };

@@ -3,8 +3,8 @@
 
 use super::Builder;
 use crate::error::{Error, Result};
-use crate::parser::did_you_mean;
 use crate::source::Loc;
+use crate::suggest::did_you_mean;
 use crate::transform::AnimatedTransform;
 use glam::DMat4;
 

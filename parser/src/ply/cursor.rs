@@ -1,6 +1,6 @@
 //! Bounds-checked reads of a PLY body's values, ascii or binary.
 
-use super::header::{Format, Kind, Scalar};
+use super::types::{Format, Kind, Scalar};
 
 /// Why a read failed; turned into a message by [`Fail::context`].
 pub(super) enum Fail {

@@ -1,7 +1,8 @@
 //! The face element: triangles and quads from the vertex index lists.
 
 use super::cursor::{decode, Cursor};
-use super::header::{Element, Format, Kind, Scalar};
+use super::header::Element;
+use super::types::{Format, Kind, Scalar};
 
 /// Where the vertex index list is in a face record.
 pub(super) struct FacePlan {

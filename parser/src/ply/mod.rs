@@ -14,13 +14,15 @@
 mod cursor;
 mod faces;
 mod header;
+mod types;
 mod vertices;
 
 use crate::mesh::Mesh;
 use cursor::Cursor;
 use faces::{read_faces, FacePlan};
-use header::{check_fits, parse_header, Element, Format};
+use header::{check_fits, parse_header, Element};
 use std::path::Path;
+use types::Format;
 use vertices::{read_vertices, VertexPlan};
 
 /// A mesh read from a PLY file, with what was skipped.

@@ -1,6 +1,6 @@
 //! The PLY reader's tests.
 
-use super::header::Scalar;
+use super::types::Scalar;
 use super::*;
 
 /// Writes PLY files: header lines, then values in the file's encoding.

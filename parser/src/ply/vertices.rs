@@ -1,7 +1,8 @@
 //! The vertex element: positions, normals and uvs, by a specialised loop where it can.
 
 use super::cursor::{arr, decode, Cursor};
-use super::header::{Element, Kind, Scalar};
+use super::header::Element;
+use super::types::{Kind, Scalar};
 use crate::mesh::Mesh;
 
 /// Slots for the vertex values pbrt uses: x y z nx ny nz u v.

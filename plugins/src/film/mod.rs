@@ -3,8 +3,8 @@
 //! pixel's own samples' count, sum and sum of squares, for the spp and variance AOVs and for
 //! filters that reconstruct from per-pixel statistics.
 
-use crate::cluster::grid::MAX_DIMS;
-use crate::cluster::{CellGrid, CellSums, CellView};
+use crate::cells::grid::MAX_DIMS;
+use crate::cells::{CellGrid, CellSums, CellView};
 use crate::first_hit::Features;
 use crate::kernel::FilterKernel;
 use crate::space::SamplePoint;

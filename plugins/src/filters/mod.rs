@@ -15,7 +15,7 @@ pub use polynomial::PolynomialFilter;
 pub use sinc::LanczosSincFilter;
 pub use triangle::TriangleFilter;
 
-use crate::cluster::CellView;
+use crate::cells::CellView;
 use crate::color::Spectrum;
 use crate::film::Film;
 pub use crate::kernel::FilterKernel;

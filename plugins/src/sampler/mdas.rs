@@ -19,7 +19,7 @@ use super::{
     pixel_key, Pcg32, PixelCursor, Sampler, SamplerBuild, SamplerReport, SamplerSetup,
     BATCH_SAMPLES,
 };
-use crate::cluster::grid::MAX_DIMS;
+use crate::cells::grid::MAX_DIMS;
 use crate::film::{luminance, Film, Spectrum};
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use crate::space::{in_pixel, RenderingSpace, SamplePoint};
@@ -647,7 +647,7 @@ pub(super) const ENTRY: Entry<SamplerBuild> = Entry {
                 "pixels one unit of time or lens counts as when choosing the longest axis",
             ),
             super::paired::STREAMS,
-            super::paired::PILOT,
+            super::paired::PILOT_ONLY,
         ],
     },
     build: build_streams,

@@ -22,7 +22,7 @@ pub use random::RandomSampler;
 pub use sobol::{SobolSampler, SOBOL_DIMS_USED, SOBOL_SAMPLES};
 pub use stratified::StratifiedSampler;
 
-use crate::cluster::CellView;
+use crate::cells::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
 use crate::registry::{Choice, Entry};

@@ -16,7 +16,7 @@
 use super::{
     alternate, pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, SamplerSetup,
 };
-use crate::cluster::CellView;
+use crate::cells::CellView;
 use crate::film::{Film, Spectrum};
 use crate::partition::Partition;
 use crate::registry::{error_at_param, float_in, int_in, Choice, ParamSpec};
@@ -24,24 +24,40 @@ use crate::space::SamplePoint;
 use acr_parser::{Param, ParamType, Result, Values};
 use std::collections::VecDeque;
 
-/// The `streams` parameter every adaptive sampler declares.
+/// The `streams` parameter every adaptive sampler declares: kept as a measured comparison.
 pub(crate) const STREAMS: ParamSpec = ParamSpec::new(
     "streams",
     ParamType::Integer,
     "1",
     "1: one stream, as the method was published; 2: two half-budget streams, each placed by \
-     the other's values, their images averaged (measured: the shift of the image mean changes \
-     sign and the MSE grows; see the README)",
+     the other's values, their images averaged. A comparison: measured, the shift of the \
+     image mean changes sign rather than vanishing and the MSE mostly grows (0.45x to 8.7x \
+     one stream's); for an unbiased mean set unbiased (cluster, gem, awr) or pilot (mdas); \
+     see docs/cluster-sampler.md",
 );
 
-/// The `pilot` parameter every adaptive sampler declares.
+/// The `pilot` parameter of the samplers that also have `unbiased` (cluster, gem, awr): kept
+/// as a measured comparison.
 pub(crate) const PILOT: ParamSpec = ParamSpec::new(
     "pilot",
     ParamType::Float,
     "0",
     "share of the budget traced first as a value-blind pilot stream that alone decides where \
      the rest goes; the image blends the two with fixed weights, so the mean is unbiased \
-     (0: off, decisions read every value, as the method was published)",
+     (0: off). A comparison: unbiased does the same without splitting the budget, where the \
+     pilot's points lose their stratification with the rest (measured: a higher MSE); see \
+     docs/cluster-sampler.md",
+);
+
+/// The `pilot` parameter of mdas, which has no `unbiased`: its way to an unbiased mean.
+pub(crate) const PILOT_ONLY: ParamSpec = ParamSpec::new(
+    "pilot",
+    ParamType::Float,
+    "0",
+    "share of the budget traced first as a value-blind pilot stream that alone decides where \
+     the rest goes; the image blends the two with fixed weights, so the mean is unbiased \
+     (0: off, decisions read every value, as the method was published). mdas's only way to \
+     an unbiased mean (pilot 0.25 measured 0.6x to 6x the published MSE); see docs/rivals.md",
 );
 
 /// Per-pixel count parameters that each stream takes half of.

@@ -1,6 +1,6 @@
 //! What the plugin tests share.
 
-use acr_plugins::cluster::CellGrid;
+use acr_plugins::cells::CellGrid;
 use acr_plugins::film::{Film, FilmSettings};
 use acr_plugins::filters::SamplerOutput;
 use acr_plugins::first_hit::Features;

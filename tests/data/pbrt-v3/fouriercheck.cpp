@@ -1,5 +1,5 @@
 // Prints pbrt-v3's FourierBSDF (core/reflection.cpp) over scenes/pbrt-v3/textures/tabulated.bsdf
-// for acr's src/fourier.rs test `fourier_bsdf_matches_pbrt_v3`: for pairs of local directions,
+// for acr's src/fourier/tests.rs test `fourier_bsdf_matches_pbrt_v3`: for pairs of local directions,
 // f (RGB) and Pdf; for given (wo, u), Sample_f's wi, f and pdf. Written for acr (CC0).
 //
 // Build against a pbrt-v3 build tree, and run from the repository root:

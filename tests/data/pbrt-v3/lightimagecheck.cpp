@@ -1,5 +1,5 @@
-// Sample_Li and Power of pbrt-v3's goniometric and projection lights, for src/light_image.rs's
-// test (output: lightimage.txt), and the images they and scenes/pbrt-v3/image-lights.pbrt use.
+// Sample_Li and Power of pbrt-v3's goniometric and projection lights, for src/light/tests.rs
+// (output: lightimage.txt), and the images they and scenes/pbrt-v3/image-lights.pbrt use.
 // Build against a pbrt-v3 build tree B (release):
 //   F=$(grep CXX_FLAGS $B/build/CMakeFiles/pbrt.dir/flags.make | cut -d= -f2-)
 //   I=$(grep CXX_INCLUDES $B/build/CMakeFiles/pbrt.dir/flags.make | cut -d= -f2-)

@@ -10,7 +10,7 @@
 //! neighbours (measured on the two-stream design; see the README).
 
 use super::{ClusterSampler, Phase};
-use crate::cluster::CellView;
+use crate::cells::CellView;
 use crate::partition::Partition;
 use crate::sampler::{alternate, PixelPattern, Sampler, SamplerReport};
 use crate::space::SamplePoint;

@@ -4,7 +4,7 @@
 
 use super::crossed::own_colour;
 use super::{ClusterSampler, SALT};
-use crate::cluster::grid::MAX_DIMS;
+use crate::cells::grid::MAX_DIMS;
 use crate::sampler::{mix64, Pcg32};
 use crate::space::SamplePoint;
 use rayon::prelude::*;

@@ -12,12 +12,12 @@ use super::{
     mix64, next_batch_where, Pcg32, PixelPattern, Sampler, SamplerReport, SobolSampler,
     BATCH_SAMPLES,
 };
-use crate::cluster::build::initial_clustering;
-use crate::cluster::clusters::UNASSIGNED;
-use crate::cluster::features::Squashed;
-use crate::cluster::grid::MAX_DIMS;
-use crate::cluster::queue::{BucketQueue, Queued};
-use crate::cluster::{CellGrid, CellSums, CellView, Clustering, FeatureScale};
+use crate::cells::build::initial_clustering;
+use crate::cells::cell_features::Squashed;
+use crate::cells::clusters::UNASSIGNED;
+use crate::cells::grid::MAX_DIMS;
+use crate::cells::queue::{BucketQueue, Queued};
+use crate::cells::{CellGrid, CellSums, CellView, Clustering, FeatureScale};
 use crate::partition::Partition;
 use crate::space::{RenderingSpace, SamplePoint};
 use rayon::prelude::*;

@@ -2,7 +2,7 @@
 //! and the parsing of a scene's or the command line's values.
 
 use super::ClusterSampler;
-use crate::cluster::build::ClusterParams;
+use crate::cells::build::ClusterParams;
 use crate::registry::{
     error_at_param, float_in, int_in, one_of, Choice, Entry, Kind, ParamSpec, PluginInfo,
 };
@@ -207,15 +207,18 @@ pub(in crate::sampler) const ENTRY: Entry<SamplerBuild> = Entry {
                 "priority",
                 ParamType::String,
                 "persample",
-                "which clusters get samples: persample (err x cells / samples) or paper (err)",
+                "which clusters get samples: persample (err x cells / samples) or paper (err: \
+                 the paper's rule, a comparison; measured 1.9x to 6.5x stratified's MSE, see \
+                 docs/cluster-sampler.md)",
             ),
             ParamSpec::new(
                 "settle",
                 ParamType::Bool,
                 "false",
                 "with --noise-threshold, a cluster whose own relative error is below the \
-                 threshold gets no more samples (measured: more error per sample than leaving \
-                 it to the priority; see the README)",
+                 threshold gets no more samples. A comparison: measured 1.1x to 1.4x the \
+                 relative MSE at the same threshold, since the priority already gives few \
+                 samples where the error is low; see docs/cluster-sampler.md",
             ),
             ParamSpec::new(
                 "unbiased",

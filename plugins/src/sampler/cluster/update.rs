@@ -4,13 +4,13 @@
 //! only queues the clusters a round sampled again, with their new counts.
 
 use super::ClusterSampler;
-use crate::cluster::features::{level, raw_gradient, raw_variance, Squashed};
-use crate::cluster::grid::MAX_DIMS;
-use crate::cluster::queue::Queued;
+use crate::cells::cell_features::{level, raw_gradient, raw_variance, Squashed};
+use crate::cells::grid::MAX_DIMS;
+use crate::cells::queue::Queued;
 use rayon::prelude::*;
 
 /// Changed cells whose clusters are read ahead of their moves at a time (see
-/// [`crate::cluster::Clustering::warm`]).
+/// [`crate::cells::Clustering::warm`]).
 const WARM_RUN: usize = 16;
 
 /// A cell whose feature changed in an update, with what the serial moves need of it.

@@ -1,7 +1,7 @@
 //! Clusters of cells (ALGORITHM.md section 4, paper eq. 10-11): connected sets of cells with
 //! similar features, grown by flood fill and kept up to date as cells change.
 
-use super::features::{Feature, FEATURE_LEN};
+use super::cell_features::{CellFeature, CELL_FEATURE_LEN};
 use super::grid::CellGrid;
 use std::collections::VecDeque;
 
@@ -12,13 +12,13 @@ pub const UNASSIGNED: u32 = u32::MAX;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Moments {
     n: f64,
-    sum: [f64; FEATURE_LEN],
+    sum: [f64; CELL_FEATURE_LEN],
     sum_sq: f64,
 }
 
 impl Moments {
     /// The mean feature F̄.
-    pub fn mean(&self) -> Feature {
+    pub fn mean(&self) -> CellFeature {
         // One division, then products: the serial parts of clustering call this often.
         let inv = 1.0 / self.n.max(1.0);
         self.sum.map(|s| s * inv)
@@ -36,7 +36,7 @@ impl Moments {
         (2.0 * (self.sum_sq * inv - mean_sq)).max(0.0).sqrt()
     }
 
-    fn add(&mut self, f: &Feature) {
+    fn add(&mut self, f: &CellFeature) {
         self.n += 1.0;
         for (s, v) in self.sum.iter_mut().zip(f) {
             *s += v;
@@ -44,7 +44,7 @@ impl Moments {
         self.sum_sq += f.iter().map(|v| v * v).sum::<f64>();
     }
 
-    fn remove(&mut self, f: &Feature) {
+    fn remove(&mut self, f: &CellFeature) {
         self.n -= 1.0;
         for (s, v) in self.sum.iter_mut().zip(f) {
             *s -= v;
@@ -53,7 +53,7 @@ impl Moments {
     }
 
     /// These moments without one member `f`.
-    fn without(mut self, f: &Feature) -> Self {
+    fn without(mut self, f: &CellFeature) -> Self {
         self.remove(f);
         self
     }
@@ -72,7 +72,7 @@ pub struct Cluster {
 
 impl Cluster {
     /// The mean feature F̄.
-    pub fn mean(&self) -> Feature {
+    pub fn mean(&self) -> CellFeature {
         self.moments.mean()
     }
 
@@ -84,7 +84,7 @@ impl Cluster {
 
 /// Euclidean distance of two features.
 #[inline]
-pub fn distance(a: &Feature, b: &Feature) -> f64 {
+pub fn distance(a: &CellFeature, b: &CellFeature) -> f64 {
     a.iter()
         .zip(b)
         .map(|(x, y)| (x - y) * (x - y))
@@ -107,7 +107,7 @@ impl Membership {
     /// Eq. 10: whether a cell with feature `f` belongs with the cells of moments `m` (which
     /// do not include it: an outlier would otherwise widen the error that judges it).
     #[inline]
-    pub fn accepts(&self, m: &Moments, f: &Feature) -> bool {
+    pub fn accepts(&self, m: &Moments, f: &CellFeature) -> bool {
         self.omega * distance(f, &m.mean()) <= m.err() + self.tolerance
     }
 }
@@ -132,7 +132,7 @@ impl Clustering {
     pub fn grow(
         grid: &CellGrid,
         rule: Membership,
-        feature: impl Fn(usize) -> Feature,
+        feature: impl Fn(usize) -> CellFeature,
         samples: impl Fn(usize) -> u64,
     ) -> Self {
         let len = grid.len();
@@ -187,7 +187,7 @@ impl Clustering {
         (self.clusters.len() - 1) as u32
     }
 
-    fn insert(&mut self, id: u32, cell: usize, f: &Feature, samples: u64) {
+    fn insert(&mut self, id: u32, cell: usize, f: &CellFeature, samples: u64) {
         let c = &mut self.clusters[id as usize];
         self.slot[cell] = c.cells.len() as u32;
         c.cells.push(cell as u32);
@@ -196,7 +196,7 @@ impl Clustering {
         self.of_cell[cell] = id;
     }
 
-    fn take(&mut self, cell: usize, f: &Feature, samples: u64) {
+    fn take(&mut self, cell: usize, f: &CellFeature, samples: u64) {
         let id = self.of_cell[cell];
         let c = &mut self.clusters[id as usize];
         let k = self.slot[cell] as usize;
@@ -221,8 +221,8 @@ impl Clustering {
         &mut self,
         grid: &CellGrid,
         cell: usize,
-        old: &Feature,
-        new: &Feature,
+        old: &CellFeature,
+        new: &CellFeature,
         samples: u64,
         nbrs: &mut Vec<usize>,
     ) -> (u32, Option<u32>) {
@@ -311,10 +311,10 @@ mod tests {
     #[test]
     fn err_is_the_rms_pairwise_distance() {
         let mut c = Cluster::default();
-        let fs: Vec<Feature> = [0.0, 1.0, 3.0, 7.0]
+        let fs: Vec<CellFeature> = [0.0, 1.0, 3.0, 7.0]
             .iter()
             .map(|&v| {
-                let mut f = [0.0; FEATURE_LEN];
+                let mut f = [0.0; CELL_FEATURE_LEN];
                 f[0] = v;
                 f[1] = v * 0.5;
                 f
@@ -345,7 +345,7 @@ mod tests {
         let g = grid(10, 4);
         let feature = |i: usize| {
             let c = g.coords(i);
-            let mut f = [0.0; FEATURE_LEN];
+            let mut f = [0.0; CELL_FEATURE_LEN];
             f[0] = if c[0] < 5 { 0.0 } else { 10.0 };
             f[3] = f64::from(c[0]) * 0.1;
             f[4] = f64::from(c[1]) * 0.1;
@@ -381,9 +381,9 @@ mod tests {
     #[test]
     fn a_refused_cell_moves_or_starts_a_cluster() {
         let g = grid(4, 1);
-        let mut fs: Vec<Feature> = (0..4)
+        let mut fs: Vec<CellFeature> = (0..4)
             .map(|x| {
-                let mut f = [0.0; FEATURE_LEN];
+                let mut f = [0.0; CELL_FEATURE_LEN];
                 f[3] = f64::from(x) * 0.1;
                 f
             })

@@ -27,7 +27,7 @@
 // The solver's loops index several small arrays at once, as the formulas do.
 #![allow(clippy::needless_range_loop)]
 
-use crate::cluster::grid::MAX_DIMS;
+use crate::cells::grid::MAX_DIMS;
 use crate::first_hit::FEATURES;
 
 /// Highest degree of the model.

@@ -1,6 +1,6 @@
 //! Image maps: converted texels with pbrt-v3's wrap modes and bilinear lookup.
 
-use super::TexValue;
+use super::value::TexValue;
 use crate::geometry::{Spectrum, Vec2};
 use crate::image_io::RgbImage;
 use std::fmt::Debug;

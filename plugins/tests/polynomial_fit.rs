@@ -7,7 +7,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use acr_plugins::first_hit::FEATURES;
-use acr_plugins::regression::{Fit, FitCell, FitSettings};
+use acr_plugins::polynomial_fit::{Fit, FitCell, FitSettings};
 use acr_plugins::rng::Pcg32;
 use nalgebra::DMatrix;
 

@@ -1,18 +1,20 @@
-//! The feature vector F = (g, s, p) of a cell (ALGORITHM.md section 3, paper eq. 2-9).
+//! The cell features: the feature vector F = (g, s, p) of a cell (docs/algorithm.md §3, paper
+//! eq. 2-9), by which cells cluster. Not the first-hit features (albedo, normal, depth) of
+//! [`crate::first_hit`].
 
 use super::grid::{CellGrid, Coords, MAX_DIMS};
 use super::sums::CellSums;
 use rayon::prelude::*;
 
 /// Length of a feature vector: g, s, the level and one position per active dim.
-pub const FEATURE_LEN: usize = 3 + MAX_DIMS;
+pub const CELL_FEATURE_LEN: usize = 3 + MAX_DIMS;
 
 /// A cell's gradient, variance and level after weighting and log-compression
 /// ([`FeatureScale::squash`]).
 pub type Squashed = [f32; 3];
 
 /// A weighted, normalised feature vector `[g, s, level, p...]`; entries past `3 + dims` are 0.
-pub type Feature = [f64; FEATURE_LEN];
+pub type CellFeature = [f64; CELL_FEATURE_LEN];
 
 /// The level `I` of every cell: its mean luminance, or for a cell without samples the mean of
 /// its face neighbours that have some (0 when none has), so that derivatives are defined
@@ -245,8 +247,8 @@ impl FeatureScale {
 
     /// The feature vector of a cell with coordinates `c` and squashed values `q`.
     #[inline]
-    pub fn feature_of(&self, dims: usize, c: &Coords, q: Squashed) -> Feature {
-        let mut f = [0.0; FEATURE_LEN];
+    pub fn feature_of(&self, dims: usize, c: &Coords, q: Squashed) -> CellFeature {
+        let mut f = [0.0; CELL_FEATURE_LEN];
         f[0] = f64::from(q[0]);
         f[1] = f64::from(q[1]);
         f[2] = f64::from(q[2]);

@@ -309,7 +309,7 @@ impl CellSums {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cluster::grid::tests::space;
+    use crate::cells::grid::tests::space;
 
     #[test]
     fn luminance_only_sums_agree_with_full_ones() {

@@ -1,17 +1,19 @@
 //! Light sources as pbrt-v3 defines them: point, spot, goniometric, projection, distant,
 //! diffuse area and infinite (constant, or an environment map sampled by importance). The
-//! goniometric and projection lights' image mappings are in [`crate::light_image`].
+//! goniometric and projection lights' image mappings are in [`light_image`].
 
 use crate::accel::{Geometry, PrimKind};
 use crate::geometry::{Frame, Spectrum, SurfaceInteraction, Vec2, Vec3};
 use crate::image_io::RgbImage;
-use crate::light_image::{delta_sample, goniometric_scale, ImageProjection, LightImage};
 use crate::mipmap::MipMap;
 use crate::sampling::Distribution2D;
 use crate::shapes::triangle::{sample_triangle, triangle_area};
 use crate::texture::{ImageMap, Wrap};
-use glam::Mat4;
+use glam::{DMat4, Mat4};
+use light_image::{goniometric_scale, ImageProjection, LightImage};
 use std::f32::consts::PI;
+
+pub mod light_image;
 
 /// A light sample as seen from a point.
 #[derive(Clone, Copy, Debug)]
@@ -594,42 +596,70 @@ pub fn spot_frame(dir: Vec3) -> Mat4 {
     .transpose()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn infinite(width: usize, rgb: Spectrum) -> Light {
-        let image = RgbImage {
-            width,
-            height: 1,
-            pixels: vec![rgb; width],
-        };
-        let m = Mat4::from_rotation_x(0.7) * Mat4::from_rotation_z(-0.3);
-        Light::Infinite {
-            l: Spectrum::new(2.0, 1.0, 0.5),
-            map: Some(EnvMap::new(&image)),
-            light_from_world: m.inverse(),
-            world_from_light: m,
-            world_radius: 10.0,
-        }
+/// A delta light's sample at `p` from `pos` along unit `wi` with intensity `intensity`
+/// (already scaled for the direction): intensity / distance², pdf 1; `None` when it sends
+/// nothing that way.
+#[inline]
+fn delta_sample(pos: Vec3, p: Vec3, wi: Vec3, intensity: Spectrum) -> Option<LightSample> {
+    if intensity == Spectrum::ZERO {
+        return None;
     }
+    Some(LightSample {
+        wi,
+        li: intensity / pos.distance_squared(p),
+        pdf: 1.0,
+        p: pos,
+    })
+}
 
-    /// A one-pixel map (pbrt-v3's constant environment) answers without spherical
-    /// coordinates: the same radiance and density as a uniform map read through them.
-    #[test]
-    fn a_constant_environment_matches_the_general_lookup() {
-        let rgb = Spectrum::new(0.3, 0.6, 0.9);
-        let (constant, general) = (infinite(1, rgb), infinite(2, rgb));
-        for k in 0..1024 {
-            let u = Vec2::new(
-                ((k % 32) as f32 + 0.5) / 32.0,
-                ((k / 32) as f32 + 0.5) / 32.0,
-            );
-            let d = crate::sampling::uniform_sample_sphere(u);
-            let (a, b) = (constant.le(d), general.le(d));
-            assert!((a - b).abs().max_element() <= 1e-6, "{d}: {a} against {b}");
-            let (a, b) = (constant.pdf_le(d), general.pdf_le(d));
-            assert!((a - b).abs() <= 1e-4 * b, "{d}: {a} against {b}");
-        }
+/// The world-to-light transform of a light placed by `world_from_light`, if it has one.
+fn light_from(world_from_light: &DMat4) -> Result<Mat4, String> {
+    let m = world_from_light.inverse().as_mat4();
+    if m.is_finite() && world_from_light.determinant() != 0.0 {
+        Ok(m)
+    } else {
+        Err("the light's transform cannot be inverted".into())
     }
 }
+
+impl Light {
+    /// pbrt-v3's `GonioPhotometricLight` at the origin of `world_from_light`, with intensity
+    /// `intensity` (I times scale) and its image, if any.
+    pub fn goniometric(
+        world_from_light: &DMat4,
+        intensity: Spectrum,
+        map: Option<LightImage>,
+    ) -> Result<Light, String> {
+        Ok(Light::Goniometric {
+            pos: world_from_light.as_mat4().transform_point3(Vec3::ZERO),
+            light_from_world: light_from(world_from_light)?,
+            intensity,
+            map,
+        })
+    }
+
+    /// pbrt-v3's `ProjectionLight` at the origin of `world_from_light`, looking along its +z,
+    /// with intensity `intensity` (I times scale), its image, if any, and field of view
+    /// `fov_degrees`.
+    pub fn projection(
+        world_from_light: &DMat4,
+        intensity: Spectrum,
+        map: Option<LightImage>,
+        fov_degrees: f32,
+    ) -> Result<Light, String> {
+        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+            return Err(format!(
+                "fov {fov_degrees} is not between 0 and 180 degrees"
+            ));
+        }
+        Ok(Light::Projection {
+            pos: world_from_light.as_mat4().transform_point3(Vec3::ZERO),
+            light_from_world: light_from(world_from_light)?,
+            intensity,
+            projection: ImageProjection::new(map, fov_degrees),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -3,8 +3,8 @@
 //! fill. The cluster sampler runs it after its first stage; the polynomial reconstruction runs
 //! it on the film's cells after any other sampler.
 
+use super::cell_features::{level, raw, Squashed};
 use super::clusters::distance;
-use super::features::{level, raw, Squashed};
 use super::{CellGrid, CellSums, Clustering, FeatureScale, Membership};
 use rayon::prelude::*;
 

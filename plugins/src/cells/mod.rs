@@ -1,17 +1,18 @@
-//! The clustering of the rendering space (ALGORITHM.md sections 2 to 4): the cell grid and its
-//! running sums, the feature vector of each cell, and clusters of cells. The cluster sampler
+//! The cells of the rendering space and their clustering (docs/algorithm.md §2 to §4): the
+//! cell grid and its running sums, the feature vector of each cell ([`cell_features`]), clusters
+//! of cells and the queue of clusters to sample. The cluster sampler (`sampler/cluster/`)
 //! drives it; a reconstruction that needs clusters builds them with the same code.
 
 pub mod build;
 pub mod by_noise;
+pub mod cell_features;
 pub mod clusters;
-pub mod features;
 pub mod grid;
 pub mod queue;
 pub mod sums;
 
+pub use cell_features::{CellFeature, FeatureScale};
 pub use clusters::{Cluster, Clustering, Membership, Moments};
-pub use features::{Feature, FeatureScale};
 pub use grid::CellGrid;
 pub use sums::CellSums;
 
