@@ -1,7 +1,10 @@
-//! Tests of the Disney BSDF against pbrt-v3's values, energy and sampling.
+//! Tests of the Disney BSDF against pbrt-v3's values, energy and sampling, its lobes built by
+//! the `disney` material from scene text as pbrt-v3 builds them.
 
 use super::*;
 use crate::bsdf::check::*;
+use crate::bsdf::{Bsdf, Bxdf};
+use crate::geometry::SurfaceInteraction;
 use crate::material::{build_materials, Material};
 use crate::sampling::uniform_sample_sphere;
 use acr_parser::parse_str;
@@ -72,7 +75,7 @@ fn pbrt_name(b: &Bxdf) -> &'static str {
 /// surface), and the same samples for 12 sample values from each of 7 directions.
 #[test]
 fn bsdf_matches_pbrt_v3() {
-    let data = include_str!("../../tests/data/pbrt-v3/disney-bsdf.txt");
+    let data = include_str!("../../../tests/data/pbrt-v3/disney-bsdf.txt");
     let num = |w: &[&str], i: usize| -> f32 { w[i].parse().unwrap() };
     let v3 = |w: &[&str], i: usize| Vec3::new(num(w, i), num(w, i + 1), num(w, i + 2));
     let mut si = flat_hit();
