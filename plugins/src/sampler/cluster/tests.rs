@@ -45,12 +45,12 @@ impl Sampler for WatchFirstStage<'_> {
     }
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        let in_first_stage = self.s.phase == Phase::Init;
+        let in_first_stage = self.s.state.phase == Phase::Init;
         let more = self.s.next_batch(out);
-        if in_first_stage && self.s.clustering.is_some() && self.at_clustering.is_none() {
-            let counts = &self.s.sums.count;
+        if in_first_stage && self.s.state.clustering.is_some() && self.at_clustering.is_none() {
+            let counts = &self.s.state.sums.count;
             self.at_clustering = Some(counts.iter().map(|&n| u64::from(n)).sum());
-        } else if in_first_stage && self.s.phase == Phase::Init && self.s.plans_ahead() {
+        } else if in_first_stage && self.s.state.phase == Phase::Init && self.s.plans_ahead() {
             self.given_ahead += 1;
         }
         more
