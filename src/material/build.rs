@@ -36,13 +36,18 @@ const UNSUPPORTED_PARAMS: [&str; 2] = ["displacement", "normalmap"];
 
 /// Builds materials from their descriptions, textures on demand.
 pub(super) struct MaterialBuilder<'a> {
+    /// The scene whose materials these are.
     pub(super) desc: &'a SceneDescription,
+    /// The textures, built as materials ask for them.
     pub(super) textures: TextureBuilder<'a>,
+    /// Each material once built (a mix shares the two it blends).
     pub(super) built: Vec<Option<Arc<Material>>>,
+    /// Materials being built: a mix that reaches one again refers to itself.
     pub(super) in_progress: Vec<bool>,
 }
 
 impl<'a> MaterialBuilder<'a> {
+    /// Material `index` of the description, built once (with its `bumpmap`, if any).
     pub(super) fn build(&mut self, index: usize) -> Result<Arc<Material>> {
         if let Some(m) = &self.built[index] {
             return Ok(Arc::clone(m));

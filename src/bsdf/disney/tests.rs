@@ -163,7 +163,7 @@ fn bsdf_matches_pbrt_v3() {
                 let reflect = s.wi.dot(si.n) * dirs[o].dot(si.n) > 0.0;
                 let lobe_kind = b.lobes()[comp].bxdf.kind();
                 if n == 1 && !reflect && !lobe_kind.contains(BxdfType::TRANSMISSION) {
-                    // A known difference (src/bsdf.rs): with one lobe pbrt-v3 keeps the
+                    // A known difference (src/bsdf/mod.rs): with one lobe pbrt-v3 keeps the
                     // lobe's value below the geometric surface; acr applies its test.
                     assert_eq!(s.f, Spectrum::ZERO, "{line}");
                     one_lobe_below += 1;
@@ -312,7 +312,7 @@ fn sampling_agrees_with_evaluation() {
             });
             if transmits && wo.z.abs() < 0.2 {
                 // pbrt-v3's rough transmission pdf also counts microfacets facing away from
-                // a grazing wo, which its sampler never picks (see src/bsdf.rs's tests).
+                // a grazing wo, which its sampler never picks (see src/bsdf/tests.rs).
                 assert!(
                     integral < 1.1 && integral + 4.0 * se + 0.01 > success,
                     "{p} {wo}"

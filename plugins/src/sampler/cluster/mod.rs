@@ -45,7 +45,7 @@ const CLUSTER_SAMPLES: (u64, u64) = (4, 16);
 const MIN_ROUND: u64 = 4096;
 
 /// The adaptive cluster sampler: its settings, the state it carries from call to call
-/// ([`state::State`]) and the buffers it reuses from round to round ([`scratch::Scratch`]).
+/// (`state::State`) and the buffers it reuses from round to round (`scratch::Scratch`).
 pub struct ClusterSampler {
     /// The settings in force.
     settings: ClusterSettings,
