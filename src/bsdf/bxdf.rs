@@ -1,14 +1,18 @@
 //! pbrt-v3's BxDFs, as one enum: each lobe's value, sampling and density in the local
 //! shading frame.
 
-use super::*;
+use super::disney::DisneyBxdf;
+use super::fresnel::{fr_dielectric, reflect, refract, Fresnel};
+use super::hair::HairBsdf;
+use super::lobe::{
+    finite_pdf, sample_microfacet_reflection, BxdfType, LobeSample, MicrofacetTransmission,
+    ONE_MINUS_EPSILON,
+};
+use crate::fourier::FourierBsdf;
 use crate::geometry::{Spectrum, Vec2, Vec3};
 use crate::microfacet::{abs_cos_theta, cos_theta, same_hemisphere, sin_theta, TrowbridgeReitz};
 use crate::sampling::cosine_sample_hemisphere;
 use std::f32::consts::FRAC_1_PI;
-
-/// The largest u < 1 in f32 (pbrt-v3's `OneMinusEpsilon`).
-pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Perfect refraction of local `wo` through the boundary between `eta_a` (the normal's side)
 /// and `eta_b`: the direction and (eta_i / eta_t)^2, the radiance scale across it. `None` on
@@ -25,90 +29,6 @@ fn specular_refraction(wo: Vec3, eta_a: f32, eta_b: f32) -> Option<(Vec3, f32)> 
         return None;
     }
     Some((wi, (eta_i * eta_i) / (eta_t * eta_t)))
-}
-
-/// pbrt-v3's generalised half vector of a refraction from local `wo` to `wi` across the
-/// boundary between `eta_a` (the normal's side) and `eta_b`, faced to +z, with the relative
-/// index eta it was made with; `None` when it is degenerate or `wo` and `wi` lie on the same
-/// side of it (not a refraction). The transmission's value and density share it.
-fn refraction_half_vector(wo: Vec3, wi: Vec3, eta_a: f32, eta_b: f32) -> Option<(Vec3, f32)> {
-    let eta = if cos_theta(wo) > 0.0 {
-        eta_b / eta_a
-    } else {
-        eta_a / eta_b
-    };
-    let wh = (wo + wi * eta).try_normalize()?;
-    let wh = if wh.z < 0.0 { -wh } else { wh };
-    if wo.dot(wh) * wi.dot(wh) > 0.0 {
-        return None;
-    }
-    Some((wh, eta))
-}
-
-/// Samples a microfacet normal of `distribution` for local `wo` and reflects `wo` about it
-/// (pbrt-v3's `MicrofacetReflection::Sample_f`): the direction and its density, from the
-/// sampled normal's (not recomputed from the direction). `None` when `wo` is grazing, the
-/// normal faces away (pbrt-v3 gives up below 0; at 0 its density would divide by zero), or the
-/// reflection leaves the hemisphere.
-pub(crate) fn sample_microfacet_reflection(
-    distribution: &TrowbridgeReitz,
-    wo: Vec3,
-    u: Vec2,
-) -> Option<(Vec3, f32)> {
-    if wo.z == 0.0 {
-        return None;
-    }
-    let wh = distribution.sample_wh(wo, u);
-    if wo.dot(wh).is_nan() || wo.dot(wh) <= 0.0 {
-        return None;
-    }
-    let wi = reflect(wo, wh);
-    if !same_hemisphere(wo, wi) {
-        return None;
-    }
-    Some((wi, distribution.pdf(wo, wh) / (4.0 * wo.dot(wh))))
-}
-
-/// The kind of a lobe, as pbrt-v3's `BxDFType` bits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BxdfType(u8);
-
-impl BxdfType {
-    /// Scatters to the side it came from.
-    pub const REFLECTION: Self = Self(1);
-    /// Scatters through the surface.
-    pub const TRANSMISSION: Self = Self(2);
-    /// Diffuse.
-    pub const DIFFUSE: Self = Self(4);
-    /// Glossy.
-    pub const GLOSSY: Self = Self(8);
-    /// A delta distribution.
-    pub const SPECULAR: Self = Self(16);
-
-    /// The union of two sets of bits.
-    #[inline]
-    pub const fn or(self, other: Self) -> Self {
-        Self(self.0 | other.0)
-    }
-
-    /// Whether every bit of `other` is set.
-    #[inline]
-    pub const fn contains(self, other: Self) -> bool {
-        self.0 & other.0 == other.0
-    }
-}
-
-/// A sample of one lobe, in local coordinates.
-#[derive(Clone, Copy, Debug)]
-pub struct LobeSample {
-    /// Sampled incident direction (local).
-    pub wi: Vec3,
-    /// Lobe value for (wo, wi).
-    pub f: Spectrum,
-    /// Density of `wi` (for specular lobes, the discrete probability of the chosen event).
-    pub pdf: f32,
-    /// What was sampled (for `FresnelSpecular`: its reflection or its transmission).
-    pub kind: BxdfType,
 }
 
 /// One of pbrt-v3's BxDFs, for radiance transport.
@@ -190,11 +110,11 @@ pub enum Bxdf {
         distribution: TrowbridgeReitz,
     },
     /// pbrt-v3's `HairBSDF` (the hair material), in a frame whose x is along the hair.
-    Hair(crate::hair::HairBsdf),
-    /// A lobe of pbrt-v3's Disney BSDF (`src/disney.rs`).
-    Disney(crate::disney::DisneyBxdf),
+    Hair(HairBsdf),
+    /// A lobe of pbrt-v3's Disney BSDF (`src/bsdf/disney/mod.rs`).
+    Disney(DisneyBxdf),
     /// pbrt-v3's tabulated `FourierBSDF` (the fourier material, `src/fourier.rs`).
-    Fourier(crate::fourier::FourierBsdf),
+    Fourier(FourierBsdf),
 }
 
 impl Bxdf {
@@ -291,36 +211,13 @@ impl Bxdf {
                 distribution,
                 eta_a,
                 eta_b,
-            } => {
-                if same_hemisphere(wo, wi) {
-                    return Spectrum::ZERO;
-                }
-                let (cos_o, cos_i) = (cos_theta(wo), cos_theta(wi));
-                if cos_i == 0.0 || cos_o == 0.0 {
-                    return Spectrum::ZERO;
-                }
-                let Some((wh, eta)) = refraction_half_vector(wo, wi, eta_a, eta_b) else {
-                    return Spectrum::ZERO;
-                };
-                let fr = fr_dielectric(wo.dot(wh), eta_a, eta_b);
-                let sqrt_denom = wo.dot(wh) + eta * wi.dot(wh);
-                if sqrt_denom == 0.0 {
-                    return Spectrum::ZERO;
-                }
-                let factor = 1.0 / eta;
-                (1.0 - fr)
-                    * t
-                    * (distribution.d(wh)
-                        * distribution.g(wo, wi)
-                        * eta
-                        * eta
-                        * wi.dot(wh).abs()
-                        * wo.dot(wh).abs()
-                        * factor
-                        * factor
-                        / (cos_i * cos_o * sqrt_denom * sqrt_denom))
-                        .abs()
+            } => MicrofacetTransmission {
+                t,
+                distribution,
+                eta_a,
+                eta_b,
             }
+            .f(wo, wi),
             Bxdf::FresnelBlend {
                 rd,
                 rs,
@@ -436,31 +333,17 @@ impl Bxdf {
                 }
             }
             Bxdf::MicrofacetTransmission {
+                t,
                 distribution,
                 eta_a,
                 eta_b,
-                ..
-            } => {
-                if wo.z == 0.0 {
-                    return None;
-                }
-                let wh = distribution.sample_wh(wo, u);
-                if wo.dot(wh).is_nan() || wo.dot(wh) <= 0.0 {
-                    return None;
-                }
-                let eta = if cos_theta(wo) > 0.0 {
-                    eta_a / eta_b
-                } else {
-                    eta_b / eta_a
-                };
-                let wi = refract(wo, wh, eta)?;
-                LobeSample {
-                    wi,
-                    f: self.f(wo, wi),
-                    pdf: self.pdf(wo, wi),
-                    kind,
-                }
+            } => MicrofacetTransmission {
+                t,
+                distribution,
+                eta_a,
+                eta_b,
             }
+            .sample_f(wo, u)?,
             Bxdf::FresnelBlend { distribution, .. } => {
                 let wi = if u.x < 0.5 {
                     let u = Vec2::new((2.0 * u.x).min(ONE_MINUS_EPSILON), u.y);
@@ -495,11 +378,7 @@ impl Bxdf {
                 LobeSample { wi, f, pdf, kind }
             }
         };
-        if s.pdf > 0.0 && s.pdf.is_finite() && s.f.is_finite() && s.wi.is_finite() {
-            Some(s)
-        } else {
-            None
-        }
+        s.valid()
     }
 
     /// Density with which [`Bxdf::sample_f`] picks local `wi` given `wo` (zero for specular
@@ -533,22 +412,17 @@ impl Bxdf {
                 distribution.pdf(wo, wh) / (4.0 * wo.dot(wh))
             }
             Bxdf::MicrofacetTransmission {
+                t,
                 distribution,
                 eta_a,
                 eta_b,
-                ..
-            } => {
-                if same_hemisphere(wo, wi) {
-                    return 0.0;
-                }
-                // The half vector faced to +z: the density is the same for either side.
-                let Some((wh, eta)) = refraction_half_vector(wo, wi, eta_a, eta_b) else {
-                    return 0.0;
-                };
-                let sqrt_denom = wo.dot(wh) + eta * wi.dot(wh);
-                let dwh_dwi = ((eta * eta * wi.dot(wh)) / (sqrt_denom * sqrt_denom)).abs();
-                distribution.pdf(wo, wh) * dwh_dwi
+            } => MicrofacetTransmission {
+                t,
+                distribution,
+                eta_a,
+                eta_b,
             }
+            .pdf(wo, wi),
             Bxdf::FresnelBlend { distribution, .. } => {
                 if !same_hemisphere(wo, wi) {
                     return 0.0;
@@ -563,10 +437,6 @@ impl Bxdf {
             Bxdf::Disney(d) => d.pdf(wo, wi),
             Bxdf::Fourier(t) => t.pdf(wo, wi),
         };
-        if p.is_finite() && p > 0.0 {
-            p
-        } else {
-            0.0
-        }
+        finite_pdf(p)
     }
 }

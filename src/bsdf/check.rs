@@ -161,6 +161,6 @@ pub fn edge_samples() -> [Vec2; 3] {
     [
         Vec2::ZERO,
         Vec2::splat(0.5),
-        Vec2::splat(super::bxdf::ONE_MINUS_EPSILON),
+        Vec2::splat(super::lobe::ONE_MINUS_EPSILON),
     ]
 }

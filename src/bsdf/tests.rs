@@ -77,7 +77,7 @@ fn non_specular_lobes() -> Vec<(&'static str, Bxdf)> {
         ),
         (
             "hair",
-            Bxdf::Hair(crate::hair::HairBsdf::new(
+            Bxdf::Hair(super::hair::HairBsdf::new(
                 0.3,
                 1.55,
                 Spectrum::ZERO,

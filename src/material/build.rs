@@ -2,7 +2,10 @@
 //! blends), with its textures; unknown types and unsupported parameters reported where they
 //! are written.
 
-use super::{Material, COPPER_ETA, COPPER_K};
+use super::{
+    DisneyMaterial, Fourier, Glass, HairMaterial, Material, Matte, Metal, Mirror, Plastic,
+    Substrate, Translucent, Uber,
+};
 use crate::geometry::Spectrum;
 use crate::texture::{Texture, TextureBuilder};
 use acr_parser::{Error, MaterialDesc, ParamList, Result, SceneDescription, Warning};
@@ -33,13 +36,18 @@ const UNSUPPORTED_PARAMS: [&str; 2] = ["displacement", "normalmap"];
 
 /// Builds materials from their descriptions, textures on demand.
 pub(super) struct MaterialBuilder<'a> {
+    /// The scene whose materials these are.
     pub(super) desc: &'a SceneDescription,
+    /// The textures, built as materials ask for them.
     pub(super) textures: TextureBuilder<'a>,
+    /// Each material once built (a mix shares the two it blends).
     pub(super) built: Vec<Option<Arc<Material>>>,
+    /// Materials being built: a mix that reaches one again refers to itself.
     pub(super) in_progress: Vec<bool>,
 }
 
 impl<'a> MaterialBuilder<'a> {
+    /// Material `index` of the description, built once (with its `bumpmap`, if any).
     pub(super) fn build(&mut self, index: usize) -> Result<Arc<Material>> {
         if let Some(m) = &self.built[index] {
             return Ok(Arc::clone(m));
@@ -82,90 +90,18 @@ impl<'a> MaterialBuilder<'a> {
             }
         }
         let t = &mut self.textures;
-        let remap = |p: &ParamList| p.bool_or("remaproughness", true);
         Ok(match kind {
-            "matte" => Material::Matte {
-                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
-                sigma: t.float_param(p, "sigma", 0.0)?,
-            },
-            "plastic" => Material::Plastic {
-                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
-                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
-                roughness: t.float_param(p, "roughness", 0.1)?,
-                remap_roughness: remap(p)?,
-            },
-            "mirror" => Material::Mirror {
-                kr: t.spectrum_param(p, "Kr", Spectrum::splat(0.9))?,
-            },
-            "glass" => {
-                let eta = match t.float_param_opt(p, "eta")? {
-                    Some(e) => e,
-                    None => t.float_param(p, "index", 1.5)?,
-                };
-                Material::Glass {
-                    kr: t.spectrum_param(p, "Kr", Spectrum::ONE)?,
-                    kt: t.spectrum_param(p, "Kt", Spectrum::ONE)?,
-                    eta,
-                    u_roughness: t.float_param(p, "uroughness", 0.0)?,
-                    v_roughness: t.float_param(p, "vroughness", 0.0)?,
-                    remap_roughness: remap(p)?,
-                }
-            }
-            "metal" => Material::Metal {
-                eta: t.spectrum_param(p, "eta", COPPER_ETA)?,
-                k: t.spectrum_param(p, "k", COPPER_K)?,
-                roughness: t.float_param(p, "roughness", 0.01)?,
-                u_roughness: t.float_param_opt(p, "uroughness")?,
-                v_roughness: t.float_param_opt(p, "vroughness")?,
-                remap_roughness: remap(p)?,
-            },
-            "uber" => {
-                let eta = match t.float_param_opt(p, "eta")? {
-                    Some(e) => e,
-                    None => t.float_param(p, "index", 1.5)?,
-                };
-                Material::Uber {
-                    kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
-                    ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
-                    kr: t.spectrum_param(p, "Kr", Spectrum::ZERO)?,
-                    kt: t.spectrum_param(p, "Kt", Spectrum::ZERO)?,
-                    roughness: t.float_param(p, "roughness", 0.1)?,
-                    u_roughness: t.float_param_opt(p, "uroughness")?,
-                    v_roughness: t.float_param_opt(p, "vroughness")?,
-                    eta,
-                    opacity: t.spectrum_param(p, "opacity", Spectrum::ONE)?,
-                    remap_roughness: remap(p)?,
-                }
-            }
-            "substrate" => Material::Substrate {
-                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
-                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.5))?,
-                u_roughness: t.float_param(p, "uroughness", 0.1)?,
-                v_roughness: t.float_param(p, "vroughness", 0.1)?,
-                remap_roughness: remap(p)?,
-            },
-            "translucent" => Material::Translucent {
-                kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.25))?,
-                ks: t.spectrum_param(p, "Ks", Spectrum::splat(0.25))?,
-                reflect: t.spectrum_param(p, "reflect", Spectrum::splat(0.5))?,
-                transmit: t.spectrum_param(p, "transmit", Spectrum::splat(0.5))?,
-                roughness: t.float_param(p, "roughness", 0.1)?,
-                remap_roughness: remap(p)?,
-            },
-            "hair" => Material::Hair(crate::hair::HairMaterial::from_params(t, p, loc)?),
-            "fourier" => {
-                let Some(name) = p.string("bsdffile")? else {
-                    return Err(Error::at(loc, "fourier material needs \"string bsdffile\""));
-                };
-                let at = p.get("bsdffile").map_or(loc, |x| &x.loc).clone();
-                let path = t.resolve_file(name, &at);
-                let table = crate::fourier::FourierTable::load(&path)
-                    .map_err(|e| Error::at(&at, format!("fourier material: {e}")))?;
-                Material::Fourier(crate::fourier::FourierBsdf { table })
-            }
-            "disney" => Material::Disney(Box::new(crate::disney::DisneyMaterial::from_params(
-                t, p, loc,
-            )?)),
+            "matte" => Material::Matte(Matte::from_params(t, p)?),
+            "plastic" => Material::Plastic(Plastic::from_params(t, p)?),
+            "mirror" => Material::Mirror(Mirror::from_params(t, p)?),
+            "glass" => Material::Glass(Glass::from_params(t, p)?),
+            "metal" => Material::Metal(Metal::from_params(t, p)?),
+            "uber" => Material::Uber(Uber::from_params(t, p)?),
+            "substrate" => Material::Substrate(Substrate::from_params(t, p)?),
+            "translucent" => Material::Translucent(Translucent::from_params(t, p)?),
+            "hair" => Material::Hair(HairMaterial::from_params(t, p, loc)?),
+            "fourier" => Material::Fourier(Fourier::from_params(t, p, loc)?),
+            "disney" => Material::Disney(Box::new(DisneyMaterial::from_params(t, p, loc)?)),
             "mix" => {
                 let amount = t.spectrum_param(p, "amount", Spectrum::splat(0.5))?;
                 let Some([a, b]) = md.mix else {
@@ -186,10 +122,10 @@ impl<'a> MaterialBuilder<'a> {
                     loc,
                     format!("material \"{k}\" is not supported; a matte with its Kd is used"),
                 );
-                Material::Matte {
+                Material::Matte(Matte {
                     kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
                     sigma: Texture::Constant(0.0),
-                }
+                })
             }
             other => return Err(unknown_kind(other, loc)),
         })

@@ -3,6 +3,7 @@
 use super::build::{used_materials, MaterialBuilder};
 use super::*;
 use crate::bsdf::check::*;
+use crate::bsdf::Bxdf;
 use crate::geometry::{Vec2, Vec3};
 use crate::texture::TextureBuilder;
 use acr_parser::{parse_str, Error, Warning};
@@ -111,12 +112,12 @@ fn typical_materials_sample_consistently_and_conserve_energy() {
 #[test]
 fn defaults_follow_pbrt_v3() {
     let (m, _) = build(&format!("Material \"plastic\"\n{SHAPE}"));
-    let Material::Plastic {
+    let Material::Plastic(Plastic {
         kd,
         ks,
         roughness,
         remap_roughness,
-    } = m.last().unwrap()
+    }) = m.last().unwrap()
     else {
         panic!()
     };
@@ -126,13 +127,13 @@ fn defaults_follow_pbrt_v3() {
     assert!(remap_roughness);
 
     let (m, _) = build(&format!("Material \"metal\"\n{SHAPE}"));
-    let Material::Metal {
+    let Material::Metal(Metal {
         eta,
         k,
         roughness,
         u_roughness,
         ..
-    } = m.last().unwrap()
+    }) = m.last().unwrap()
     else {
         panic!()
     };
@@ -142,7 +143,7 @@ fn defaults_follow_pbrt_v3() {
     assert!(u_roughness.is_none());
 
     // The default material (index 0) is matte 0.5.
-    let Material::Matte { kd, sigma } = &m[0] else {
+    let Material::Matte(Matte { kd, sigma }) = &m[0] else {
         panic!()
     };
     assert_eq!(kd.as_constant(), Some(Spectrum::splat(0.5)));
@@ -150,12 +151,12 @@ fn defaults_follow_pbrt_v3() {
 
     // Glass takes "eta", or else "index".
     let (m, _) = build(&format!("Material \"glass\" \"float index\" 1.33\n{SHAPE}"));
-    let Material::Glass { eta, .. } = m.last().unwrap() else {
+    let Material::Glass(Glass { eta, .. }) = m.last().unwrap() else {
         panic!()
     };
     assert_eq!(eta.as_constant(), Some(1.33));
     let (m, _) = build(&format!("Material \"glass\" \"float eta\" 2.4\n{SHAPE}"));
-    let Material::Glass { eta, .. } = m.last().unwrap() else {
+    let Material::Glass(Glass { eta, .. }) = m.last().unwrap() else {
         panic!()
     };
     assert_eq!(eta.as_constant(), Some(2.4));
@@ -299,7 +300,7 @@ fn unsupported_parameters_warn_once_and_unknown_types_fail() {
         "Material \"subsurface\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
     ));
     assert_eq!(w.len(), 1);
-    assert!(matches!(m.last().unwrap(), Material::Matte { .. }));
+    assert!(matches!(m.last().unwrap(), Material::Matte(_)));
     // fourier reads its table (issue 27): without one, a located error.
     let e = build_err(&format!(
         "Material \"fourier\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
@@ -341,7 +342,7 @@ fn unused_materials_load_no_images() {
             Shape "sphere""#;
     let (m, w) = build_in(text, &dir);
     assert!(w.is_empty(), "{w:?}");
-    assert!(matches!(m.last().unwrap(), Material::Plastic { .. }));
+    assert!(matches!(m.last().unwrap(), Material::Plastic(_)));
     // Used, it is an error.
     let text = text.replace("Material \"plastic\"\n", "");
     let full = format!("WorldBegin\n{text}\nWorldEnd\n");

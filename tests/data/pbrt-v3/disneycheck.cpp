@@ -1,4 +1,4 @@
-// Prints pbrt-v3's DisneyMaterial BSDF (materials/disney.cpp) for acr's src/disney.rs test
+// Prints pbrt-v3's DisneyMaterial BSDF (materials/disney.cpp) for acr's src/bsdf/disney/tests.rs test
 // `bsdf_matches_pbrt_v3`: for each parameter set, the BSDF built by
 // DisneyMaterial::ComputeScatteringFunctions on a SurfaceInteraction with tilted geometric
 // and shading frames, then bsdf->f, bsdf->Pdf (and each lobe's f and Pdf in the local frame)

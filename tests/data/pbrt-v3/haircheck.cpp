@@ -1,5 +1,5 @@
 // pbrt-v3's HairBSDF (materials/hair.{h,cpp}) on random configurations and directions, for
-// src/hair.rs's `values_match_pbrt_v3` test. Build (from the repository root), with pbrt-v3's
+// src/bsdf/hair/tests.rs's `values_match_pbrt_v3` test. Build (from the repository root), with pbrt-v3's
 // flags, compiling its hair.cpp and reflection.cpp again without fused multiply-adds (its
 // -march=native build fuses them, which moves f and Pdf by up to 2.4e-4 relative in the
 // sharpest lobes; without, acr's values are the same floats):

@@ -21,7 +21,7 @@ impl ClusterSampler {
     /// adaptive samples of the pixels of colour `colour` (0 or 1): its budget is theirs.
     pub(super) fn for_colour(mut self, colour: u32) -> Self {
         self.settings.colour = Some(colour);
-        self.remaining = self.adaptive_budget();
+        self.state.remaining = self.adaptive_budget();
         self
     }
 
@@ -33,7 +33,7 @@ impl ClusterSampler {
 
     /// Whether its next call ends its first stage and clusters.
     pub(super) fn about_to_cluster(&self) -> bool {
-        self.phase == Phase::Init && !self.init.cursor().has_next()
+        self.state.phase == Phase::Init && !self.state.init.cursor().has_next()
     }
 
     /// The pixels whose adaptive samples it places: all, or those of its colour.
@@ -112,7 +112,7 @@ impl Crossed {
     /// about to cluster while the other's first stage is not all observed
     /// (`first_unobserved(other)`), when the other can go instead.
     fn next_half(&self, first_unobserved: impl Fn(usize) -> bool) -> Option<usize> {
-        let live = |h: usize| !self.done[h] && self.halves[h].phase != Phase::Done;
+        let live = |h: usize| !self.done[h] && self.halves[h].state.phase != Phase::Done;
         let waits = |h: usize| self.halves[h].about_to_cluster() && first_unobserved(1 - h);
         let order = [self.turn, 1 - self.turn];
         order
@@ -154,7 +154,7 @@ impl Sampler for Crossed {
         // The call that ends the first stage clusters and plans the first round: the phase
         // after the call tells which the batch is.
         // (Each half's first stage makes its own colour's pixels' points only.)
-        let first_stage = self.halves[h].phase == Phase::Init;
+        let first_stage = self.halves[h].state.phase == Phase::Init;
         self.given.push_back((h, first_stage));
         self.last = Some(h);
         if self.halt_after_next == Some(h) {

@@ -34,14 +34,14 @@ impl ClusterSampler {
     /// and each gets the pixel's next index; `out` holds them sorted by row, the rest of each
     /// point left to be made.
     pub(super) fn draw_pixels(&mut self, picks: &[(u32, u64)], out: &mut Vec<SamplePoint>) {
-        let clustering = self.clustering.as_ref().expect("clustered");
-        let per_pixel = self.grid.cells_per_pixel();
+        let clustering = self.state.clustering.as_ref().expect("clustered");
+        let per_pixel = self.state.grid.cells_per_pixel();
         let width = self.space.width() as usize;
         let rows = self.space.height() as usize;
         // Each pick draws from its own stream, so that picks are drawn in parallel and the
         // pixels do not depend on the thread count.
-        let round_key = mix64(self.seed ^ SALT ^ mix64(self.rounds));
-        let (grid, space) = (&self.grid, &self.space);
+        let round_key = mix64(self.seed ^ SALT ^ mix64(self.state.rounds));
+        let (grid, space) = (&self.state.grid, &self.space);
         let colour = self.settings.colour;
         let groups: Vec<Vec<u64>> = picks
             .par_chunks(PICKS_PER_TASK)
@@ -83,7 +83,7 @@ impl ClusterSampler {
                 drawn
             })
             .collect();
-        let mut drawn = std::mem::take(&mut self.drawn);
+        let mut drawn = std::mem::take(&mut self.scratch.drawn);
         drawn.clear();
         drawn.extend(groups.into_iter().flatten());
         let mut start = vec![0usize; rows + 1];
@@ -109,10 +109,10 @@ impl ClusterSampler {
         // points keep their draw order, so they get the same indices either way.
         for q in out.iter_mut() {
             let p = (q.pixel[1] - y0) as usize * width + (q.pixel[0] - x0) as usize;
-            q.index = self.pixel_count[p];
-            self.pixel_count[p] += 1;
+            q.index = self.state.pixel_count[p];
+            self.state.pixel_count[p] += 1;
         }
-        self.drawn = drawn;
+        self.scratch.drawn = drawn;
     }
 
     /// Draws the round's points inside the chosen cells themselves (evenpixels false): each a
@@ -123,8 +123,8 @@ impl ClusterSampler {
         rng: &mut Pcg32,
         out: &mut Vec<SamplePoint>,
     ) {
-        let clustering = self.clustering.as_ref().expect("clustered");
-        let n = self.grid.dims();
+        let clustering = self.state.clustering.as_ref().expect("clustered");
+        let n = self.state.grid.dims();
         let mut points: Vec<(SamplePoint, u32, [f32; MAX_DIMS])> = Vec::new();
         for &(id, k) in picks {
             let cells = &clustering.clusters[id as usize].cells;
@@ -134,10 +134,10 @@ impl ClusterSampler {
                     *v = rng.next_f32();
                 }
                 let cell = cells[slot];
-                let mut q = self.grid.point(cell as usize, &u);
+                let mut q = self.state.grid.point(cell as usize, &u);
                 let p = self.space.index_of(q.pixel);
-                q.index = self.settings.stream.index(self.pixel_count[p]);
-                self.pixel_count[p] += 1;
+                q.index = self.settings.stream.index(self.state.pixel_count[p]);
+                self.state.pixel_count[p] += 1;
                 points.push((q, cell, u));
             }
         }
@@ -151,15 +151,17 @@ impl ClusterSampler {
             start[r + 1] += start[r];
         }
         out.clear();
-        self.round_cells.clear();
+        self.scratch.round_cells.clear();
         if let Some(first) = points.first() {
             out.resize(points.len(), first.0);
-            self.round_cells.resize(points.len(), (first.1, first.2));
+            self.scratch
+                .round_cells
+                .resize(points.len(), (first.1, first.2));
         }
         for (q, cell, u) in points {
             let r = &mut start[(q.pixel[1] - y0) as usize];
             out[*r] = q;
-            self.round_cells[*r] = (cell, u);
+            self.scratch.round_cells[*r] = (cell, u);
             *r += 1;
         }
     }

@@ -13,11 +13,9 @@ use super::{
     BATCH_SAMPLES,
 };
 use crate::cells::build::initial_clustering;
-use crate::cells::cell_features::Squashed;
-use crate::cells::clusters::UNASSIGNED;
 use crate::cells::grid::MAX_DIMS;
-use crate::cells::queue::{BucketQueue, Queued};
-use crate::cells::{CellGrid, CellSums, CellView, Clustering, FeatureScale};
+use crate::cells::queue::BucketQueue;
+use crate::cells::{CellGrid, CellSums, CellView, Clustering};
 use crate::partition::Partition;
 use crate::space::{RenderingSpace, SamplePoint};
 use rayon::prelude::*;
@@ -26,8 +24,11 @@ mod crossed;
 mod draw;
 mod noise;
 mod plan;
+mod scratch;
+mod state;
 mod update;
-use update::{CellUpdate, Change};
+use scratch::Scratch;
+use state::{Phase, Round, State};
 mod settings;
 #[cfg(test)]
 use settings::build;
@@ -43,90 +44,19 @@ const CLUSTER_SAMPLES: (u64, u64) = (4, 16);
 /// Smallest round, in samples: enough to keep every thread busy.
 const MIN_ROUND: u64 = 4096;
 
-/// Where the sampler is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Phase {
-    Init,
-    Adaptive,
-    Done,
-}
-
-/// A planned round, until it is observed.
-#[derive(Default)]
-struct Round {
-    /// How many points it has.
-    points: usize,
-    /// Its points' cells and in-cell offsets, in batch order: kept only by a sampler that
-    /// learns its own rounds' values (see [`ClusterSampler::learns_own_rounds`]).
-    cells: Vec<(u32, [f32; MAX_DIMS])>,
-    /// The queue entries of the clusters it sampled, as picked, in order.
-    picked: Vec<Queued>,
-    /// Room for their ids, which the update after the round lists (reused).
-    ids: Vec<u32>,
-}
-
-impl Round {
-    /// The ids of the clusters it sampled, in the order picked, in its reused buffer.
-    fn picked_ids(&mut self) -> Vec<u32> {
-        let mut ids = std::mem::take(&mut self.ids);
-        ids.clear();
-        ids.extend(self.picked.iter().map(|e| e.id));
-        ids
-    }
-}
-
-/// The adaptive cluster sampler.
+/// The adaptive cluster sampler: its settings, the state it carries from call to call
+/// (`state::State`) and the buffers it reuses from round to round (`scratch::Scratch`).
 pub struct ClusterSampler {
+    /// The settings in force.
     settings: ClusterSettings,
+    /// The seed every random decision is drawn from.
     seed: u64,
+    /// The rendering space it samples.
     space: RenderingSpace,
-    phase: Phase,
-    halted: bool,
-    init: SobolSampler,
-    grid: CellGrid,
-    sums: CellSums,
-    levels: Vec<f32>,
-    /// The squashed (g, s, level) each cell's current feature was made with (its level may
-    /// have moved since).
-    squashed: Vec<Squashed>,
-    scale: Option<FeatureScale>,
-    clustering: Option<Clustering>,
-    /// Samples given to each pixel so far: the next sample's index there.
-    pixel_count: Vec<u32>,
-    /// Adaptive samples still to give.
-    remaining: u64,
-    /// Adaptive samples given so far.
-    given_adaptive: u64,
-    queue: BucketQueue,
-    version: Vec<u32>,
-    /// The cell and in-cell offsets of each point of the round being planned (or of the
-    /// first stage's batch being observed), in batch order.
-    round_cells: Vec<(u32, [f32; MAX_DIMS])>,
-    /// Rounds planned and not yet observed, oldest first: their points' cells and clusters.
-    in_flight: std::collections::VecDeque<Round>,
-    /// Observed rounds' buffers, for reuse.
-    spare: Vec<Round>,
-    /// The pixel (row << 32 | column, from the space's corner) of each point drawn in a
-    /// round, in draw order (reused).
-    drawn: Vec<u64>,
-    /// A bit per cell: whether it got samples since the last update.
-    touched: Vec<u64>,
-    /// A bit per cluster, clear between updates: the update's scratch for listing each
-    /// changed cluster once.
-    cluster_marks: Vec<u64>,
-    /// Cells without samples, as of the last update (their levels follow their neighbours').
-    empty_cells: usize,
-    /// The update's buffers, kept from round to round: fresh ones cost page faults.
-    dirty: Vec<u32>,
-    cell_updates: Vec<CellUpdate>,
-    changes: Vec<Change>,
-    /// The sample counts of the clusters a round picked (reused; see `requeue_picked`).
-    counts: Vec<u64>,
-    rounds: u64,
-    partition: Option<Partition>,
-    /// With `--noise-threshold`: the threshold, and the samples each cell of a cluster needs
-    /// before the cluster may settle.
-    noise: Option<(f64, u32)>,
+    /// Where it is, what it has learnt, what it has given.
+    state: State,
+    /// Buffers reused between rounds.
+    scratch: Scratch,
 }
 
 impl ClusterSampler {
@@ -146,17 +76,11 @@ impl ClusterSampler {
         };
         let cells = grid.len();
         let pixels = space.pixels();
-        Self {
-            init: SobolSampler::new(space, settings.init_spp, seed ^ SALT)
-                .with_stream(settings.stream),
-            // The whole image's until `for_colour` says otherwise.
-            remaining: pixels * u64::from(settings.spp - settings.init_spp),
-            given_adaptive: 0,
-            settings,
-            seed,
-            space,
+        let state = State {
             phase: Phase::Init,
             halted: false,
+            init: SobolSampler::new(space, settings.init_spp, seed ^ SALT)
+                .with_stream(settings.stream),
             grid,
             sums,
             levels: Vec::new(),
@@ -164,22 +88,23 @@ impl ClusterSampler {
             scale: None,
             clustering: None,
             pixel_count: vec![0; pixels as usize],
+            // The whole image's until `for_colour` says otherwise.
+            remaining: pixels * u64::from(settings.spp - settings.init_spp),
+            given_adaptive: 0,
             queue: BucketQueue::new(),
             version: Vec::new(),
-            round_cells: Vec::new(),
             in_flight: Default::default(),
-            spare: Vec::new(),
-            drawn: Vec::new(),
-            touched: vec![0; cells.div_ceil(64)],
-            cluster_marks: Vec::new(),
             empty_cells: cells,
-            dirty: Vec::new(),
-            cell_updates: Vec::new(),
-            changes: Vec::new(),
-            counts: Vec::new(),
             rounds: 0,
             partition: None,
             noise: None,
+        };
+        Self {
+            settings,
+            seed,
+            space,
+            state,
+            scratch: Scratch::new(cells),
         }
     }
 
@@ -190,121 +115,76 @@ impl ClusterSampler {
 
     /// The cell grid.
     pub fn grid(&self) -> &CellGrid {
-        &self.grid
+        &self.state.grid
     }
 
     /// The cells' running sums.
     pub fn sums(&self) -> &CellSums {
-        &self.sums
+        &self.state.sums
     }
 
     /// The clustering, once the first stage is done.
     pub fn clustering(&self) -> Option<&Clustering> {
-        self.clustering.as_ref()
+        self.state.clustering.as_ref()
     }
 
     /// Bytes held by the sampler's per-cell and per-pixel state.
     pub fn bytes(&self) -> usize {
-        self.sums.bytes()
-            + self.levels.capacity() * 4
-            + self.squashed.capacity() * std::mem::size_of::<Squashed>()
-            + self.touched.capacity() * 8
-            + self.pixel_count.capacity() * 4
-            + self.clustering.as_ref().map_or(0, Clustering::bytes)
-            + self.queue.bytes()
-    }
-
-    /// The sampling priority of a queued cluster.
-    fn priority(&self, e: &Queued) -> f64 {
-        match self.settings.priority {
-            Priority::Paper => e.weight,
-            Priority::PerSample => e.weight / e.samples.max(1) as f64,
-        }
-    }
-
-    /// The queue entry of cluster `id` as it stands, with its priority; none for a dead one.
-    fn entry(&self, id: u32) -> Option<(f64, Queued)> {
-        let clustering = self.clustering.as_ref().expect("clustered");
-        let c = &clustering.clusters[id as usize];
-        if c.cells.is_empty() {
-            return None;
-        }
-        let weight = match self.settings.priority {
-            Priority::Paper => c.err(),
-            Priority::PerSample => {
-                // A cluster of cells that agree has err 0 however noisy or curved they are:
-                // its mean gradient and variance features count too.
-                let mean = c.mean();
-                let err = c.err() + mean[0].abs() + mean[1].abs() + clustering.rule.tolerance;
-                err * c.cells.len() as f64
-            }
-        };
-        let e = Queued {
-            id,
-            version: self.version[id as usize],
-            cells: c.cells.len() as u32,
-            samples: c.samples,
-            weight,
-        };
-        Some((self.priority(&e), e))
-    }
-
-    /// Queues the clusters `ids` in the order given.
-    fn push_all(&mut self, ids: impl IntoIterator<Item = u32>) {
-        for id in ids {
-            if let Some((priority, e)) = self.entry(id) {
-                self.queue.push(priority, e);
-            }
-        }
+        self.state.bytes() + self.scratch.bytes()
     }
 
     /// Ends the first stage: every cell's level and features, their scales, the clusters.
     fn cluster(&mut self) {
-        let initial = initial_clustering(&self.grid, &self.sums, &self.settings.cluster_params());
-        self.squashed = initial.squashed;
-        self.levels = initial.levels;
-        self.scale = Some(initial.scale);
+        let initial = initial_clustering(
+            &self.state.grid,
+            &self.state.sums,
+            &self.settings.cluster_params(),
+        );
+        self.state.squashed = initial.squashed;
+        self.state.levels = initial.levels;
+        self.state.scale = Some(initial.scale);
         let clustering = initial.clustering;
-        self.version = vec![0; clustering.clusters.len()];
-        self.clustering = Some(clustering);
-        self.push_all(0..self.version.len() as u32);
+        self.state.version = vec![0; clustering.clusters.len()];
+        self.state.clustering = Some(clustering);
+        let n = self.state.version.len() as u32;
+        self.state.push_all(self.settings.priority, 0..n);
     }
 
     /// Plans the next round into `out`: clusters by priority, a few samples each, until the
     /// round holds its share of what is left.
     fn plan_round(&mut self, out: &mut Vec<SamplePoint>) {
-        let target = (self.remaining / 16)
+        let target = (self.state.remaining / 16)
             .clamp(MIN_ROUND, BATCH_SAMPLES)
-            .min(self.remaining);
+            .min(self.state.remaining);
         let Round {
             cells,
             mut picked,
             ids,
             ..
-        } = self.spare.pop().unwrap_or_default();
+        } = self.scratch.spare.pop().unwrap_or_default();
         picked.clear();
-        self.round_cells = cells;
+        self.scratch.round_cells = cells;
         let mut picks: Vec<(u32, u64)> = Vec::new();
         let mut planned_total = 0;
         let mut deferred = Vec::new();
         while planned_total < target {
-            let Some(mut top) = self.queue.pop() else {
+            let Some(mut top) = self.state.queue.pop() else {
                 if deferred.is_empty() {
                     break;
                 }
                 for (priority, e) in deferred.drain(..) {
-                    self.queue.push(priority, e);
+                    self.state.queue.push(priority, e);
                 }
                 continue;
             };
             // A live entry's cluster has cells: a cluster that loses its last one changes
             // version.
-            if self.version[top.id as usize] != top.version {
+            if self.state.version[top.id as usize] != top.version {
                 continue;
             }
             // A settled cluster leaves the queue; a move into or out of it queues it again.
-            let settled = |(t, least)| self.relative_error(top.id, least) < t;
-            if self.settings.settle && self.noise.is_some_and(settled) {
+            let settled = |(t, least)| self.state.relative_error(top.id, least) < t;
+            if self.settings.settle && self.state.noise.is_some_and(settled) {
                 continue;
             }
             let k = u64::from(top.cells)
@@ -314,25 +194,25 @@ impl ClusterSampler {
             picked.push(top);
             planned_total += k;
             top.samples += k;
-            let priority = self.priority(&top);
+            let priority = state::priority(self.settings.priority, &top);
             match self.settings.priority {
-                Priority::PerSample => self.queue.push(priority, top),
+                Priority::PerSample => self.state.queue.push(priority, top),
                 // The paper's rule takes each cluster once per round, by largest error.
                 Priority::Paper => deferred.push((priority, top)),
             }
         }
         for (priority, e) in deferred {
-            self.queue.push(priority, e);
+            self.state.queue.push(priority, e);
         }
 
         // Every planned sample is spent, whether or not it comes back valid.
-        let clustering = self.clustering.as_mut().expect("clustered");
+        let clustering = self.state.clustering.as_mut().expect("clustered");
         for &(id, k) in &picks {
             clustering.spend(id, k);
         }
         if self.settings.even_pixels {
             self.draw_pixels(&picks, out);
-            let (init, grid) = (&self.init, &self.grid);
+            let (init, grid) = (&self.state.init, &self.state.grid);
             let seed = init.seed();
             let stream = self.settings.stream;
             // The pixel's next point of its sequence, labelled with the stream's index.
@@ -341,11 +221,13 @@ impl ClusterSampler {
                 *q = init.point(q.pixel, local, Scramble::of(q.pixel, seed));
                 q.index = stream.index(local);
             };
-            self.round_cells.clear();
+            self.scratch.round_cells.clear();
             if self.learns_own_rounds() {
-                self.round_cells.resize(out.len(), (0, [0.0; MAX_DIMS]));
+                self.scratch
+                    .round_cells
+                    .resize(out.len(), (0, [0.0; MAX_DIMS]));
                 out.par_iter_mut()
-                    .zip(self.round_cells.par_iter_mut())
+                    .zip(self.scratch.round_cells.par_iter_mut())
                     .with_min_len(256)
                     .for_each(|(q, slot)| {
                         make(q);
@@ -356,18 +238,18 @@ impl ClusterSampler {
                 out.par_iter_mut().with_min_len(256).for_each(make);
             }
         } else {
-            let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.rounds);
+            let mut rng = Pcg32::new(mix64(self.seed ^ SALT), self.state.rounds);
             self.draw_cells(&picks, &mut rng, out);
         }
-        self.in_flight.push_back(Round {
+        self.state.in_flight.push_back(Round {
             points: out.len(),
-            cells: std::mem::take(&mut self.round_cells),
+            cells: std::mem::take(&mut self.scratch.round_cells),
             picked,
             ids,
         });
-        self.remaining -= planned_total;
-        self.given_adaptive += planned_total;
-        self.rounds += 1;
+        self.state.remaining -= planned_total;
+        self.state.given_adaptive += planned_total;
+        self.state.rounds += 1;
     }
 
     /// Whether its own rounds' values come back to it ([`Sampler::observe`]): not for a half
@@ -376,58 +258,11 @@ impl ClusterSampler {
         self.settings.colour.is_none() && self.settings.stream == super::IndexStream::ALL
     }
 
-    /// The final partition in image space: each pixel takes the cluster of most of the cells
-    /// at its centre (ties to the lower id), ids renumbered in order of first appearance.
-    fn make_partition(&self) -> Option<Partition> {
-        let clustering = self.clustering.as_ref()?;
-        let (w, h) = (self.space.width(), self.space.height());
-        let inner = self.grid.cells_per_image_cell();
-        let mut renumber = vec![UNASSIGNED; clustering.clusters.len()];
-        let mut next = 0;
-        let mut cluster = Vec::with_capacity(w as usize * h as usize);
-        let mut votes: Vec<u32> = Vec::with_capacity(inner);
-        for py in 0..h {
-            for px in 0..w {
-                let (cx, cy) = self.grid.image_cell_of_pixel(px, py);
-                let mut c = [0; MAX_DIMS];
-                c[0] = cx;
-                c[1] = cy;
-                let first = self.grid.index(&c);
-                votes.clear();
-                votes.extend((first..first + inner).map(|i| clustering.of_cell[i]));
-                votes.sort_unstable();
-                let mut best = (0, votes[0]);
-                let mut run = 0;
-                for (k, &v) in votes.iter().enumerate() {
-                    run = if k > 0 && votes[k - 1] == v {
-                        run + 1
-                    } else {
-                        1
-                    };
-                    if run > best.0 {
-                        best = (run, v);
-                    }
-                }
-                let id = &mut renumber[best.1 as usize];
-                if *id == UNASSIGNED {
-                    *id = next;
-                    next += 1;
-                }
-                cluster.push(*id);
-            }
-        }
-        Some(Partition {
-            width: w,
-            height: h,
-            cluster,
-        })
-    }
-
     fn finish(&mut self) {
-        self.phase = Phase::Done;
+        self.state.phase = Phase::Done;
         // Made once the rounds still in flight are observed.
-        if self.partition.is_none() && self.in_flight.is_empty() {
-            self.partition = self.make_partition();
+        if self.state.partition.is_none() && self.state.in_flight.is_empty() {
+            self.state.partition = self.state.make_partition(&self.space);
         }
     }
 }
@@ -443,35 +278,35 @@ impl Sampler for ClusterSampler {
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
         out.clear();
-        if self.phase == Phase::Init {
+        if self.state.phase == Phase::Init {
             // Half of an unbiased pair: the first stage of its own colour's pixels only (the
             // other half makes the other's).
             let (x0, y0) = (self.space.x0, self.space.y0);
             let given = match self.settings.colour {
-                Some(c) => {
-                    next_batch_where(&mut self.init, out, |p| (p[0] - x0 + p[1] - y0) & 1 == c)
-                }
-                None => self.init.next_batch(out),
+                Some(c) => next_batch_where(&mut self.state.init, out, |p| {
+                    (p[0] - x0 + p[1] - y0) & 1 == c
+                }),
+                None => self.state.init.next_batch(out),
             };
             if given {
                 for q in out.iter() {
                     let p = self.space.index_of(q.pixel);
-                    self.pixel_count[p] += 1;
+                    self.state.pixel_count[p] += 1;
                 }
                 return true;
             }
             if self.space.pixels() == 0 {
-                self.phase = Phase::Done;
+                self.state.phase = Phase::Done;
                 return false;
             }
             self.cluster();
-            self.phase = if self.halted {
+            self.state.phase = if self.state.halted {
                 Phase::Done
             } else {
                 Phase::Adaptive
             };
         }
-        if self.phase == Phase::Adaptive && !self.halted && self.remaining > 0 {
+        if self.state.phase == Phase::Adaptive && !self.state.halted && self.state.remaining > 0 {
             self.plan_round(out);
             if !out.is_empty() {
                 return true;
@@ -484,27 +319,33 @@ impl Sampler for ClusterSampler {
     fn observe(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
         // An adaptive point's cell is known from when it was made; the first stage's are
         // found here, in parallel.
-        let round = match self.in_flight.front() {
-            Some(r) if r.points == batch.len() => self.in_flight.pop_front(),
+        let round = match self.state.in_flight.front() {
+            Some(r) if r.points == batch.len() => self.state.in_flight.pop_front(),
             _ => None,
         };
         let Some(mut round) = round else {
-            self.grid.locate_all(batch, &mut self.round_cells);
-            self.sums.add_batch(&self.round_cells, radiance, None);
+            self.state
+                .grid
+                .locate_all(batch, &mut self.scratch.round_cells);
+            self.state
+                .sums
+                .add_batch(&self.scratch.round_cells, radiance, None);
             return;
         };
         // NaN marks a dropped sample: it was spent (when planned) but tells nothing.
-        self.sums.add_batch(&round.cells, radiance, None);
+        self.state.sums.add_batch(&round.cells, radiance, None);
         for (&(cell, _), l) in round.cells.iter().zip(radiance) {
             if !l[0].is_nan() {
-                self.touched[cell as usize / 64] |= 1 << (cell % 64);
+                self.scratch.touched[cell as usize / 64] |= 1 << (cell % 64);
             }
         }
         // A round is one batch: update now.
         let ids = round.picked_ids();
-        round.ids = self.update(ids);
-        self.spare.push(round);
-        if self.phase == Phase::Done {
+        round.ids = self
+            .state
+            .update(&mut self.scratch, self.settings.priority, ids);
+        self.scratch.spare.push(round);
+        if self.state.phase == Phase::Done {
             self.finish();
         }
     }
@@ -512,45 +353,49 @@ impl Sampler for ClusterSampler {
     fn observe_other(&mut self, batch: &[SamplePoint], radiance: &[[f32; 3]]) {
         // The other stream's points: their cells found here, their values learnt as this
         // sampler's own would be.
-        let mut cells = std::mem::take(&mut self.round_cells);
-        self.grid.locate_all(batch, &mut cells);
-        self.sums.add_batch(&cells, radiance, None);
-        if self.clustering.is_some() {
+        let mut cells = std::mem::take(&mut self.scratch.round_cells);
+        self.state.grid.locate_all(batch, &mut cells);
+        self.state.sums.add_batch(&cells, radiance, None);
+        if self.state.clustering.is_some() {
             for (&(cell, _), l) in cells.iter().zip(radiance) {
                 if !l[0].is_nan() {
-                    self.touched[cell as usize / 64] |= 1 << (cell % 64);
+                    self.scratch.touched[cell as usize / 64] |= 1 << (cell % 64);
                 }
             }
-            self.update(Vec::new());
+            let rule = self.settings.priority;
+            self.state.update(&mut self.scratch, rule, Vec::new());
         }
-        self.round_cells = cells;
+        self.scratch.round_cells = cells;
     }
 
     fn retire(&mut self, batch: &[SamplePoint]) {
         // Its own round, traced for the other stream: only the clusters it sampled are queued
         // again with their new sample counts.
-        let round = match self.in_flight.front() {
-            Some(r) if r.points == batch.len() => self.in_flight.pop_front(),
+        let round = match self.state.in_flight.front() {
+            Some(r) if r.points == batch.len() => self.state.in_flight.pop_front(),
             _ => None,
         };
         if let Some(mut round) = round {
             let ids = round.picked_ids();
             round.ids = if self.settings.colour.is_some() {
                 // A half of an unbiased pair learns nothing after its first stage.
-                self.requeue_picked(&mut round.picked, ids)
+                let rule = self.settings.priority;
+                self.state
+                    .requeue_picked(&mut self.scratch, rule, &mut round.picked, ids)
             } else {
-                self.update(ids)
+                self.state
+                    .update(&mut self.scratch, self.settings.priority, ids)
             };
-            self.spare.push(round);
+            self.scratch.spare.push(round);
         }
-        if self.phase == Phase::Done {
+        if self.state.phase == Phase::Done {
             self.finish();
         }
     }
 
     fn halt(&mut self) {
-        self.halted = true;
-        self.init.halt();
+        self.state.halted = true;
+        self.state.init.halt();
     }
 
     fn stop_at_noise(&mut self, threshold: f64, min_spp: u32) -> bool {
@@ -565,24 +410,24 @@ impl Sampler for ClusterSampler {
     }
 
     fn plans_ahead(&self) -> bool {
-        match self.phase {
+        match self.state.phase {
             // The first stage's points depend on nothing observed, but the call after its
             // last batch makes the first clustering, which needs every batch observed.
-            Phase::Init => self.init.cursor().has_next(),
+            Phase::Init => self.state.init.cursor().has_next(),
             Phase::Adaptive => true,
             Phase::Done => false,
         }
     }
 
     fn partition(&self) -> Option<&Partition> {
-        self.partition.as_ref()
+        self.state.partition.as_ref()
     }
 
     fn cells(&self) -> Option<CellView<'_>> {
         self.settings.keep_radiance.then_some(CellView {
-            grid: &self.grid,
-            sums: &self.sums,
-            clustering: self.clustering.as_ref(),
+            grid: &self.state.grid,
+            sums: &self.state.sums,
+            clustering: self.state.clustering.as_ref(),
         })
     }
 
@@ -592,9 +437,9 @@ impl Sampler for ClusterSampler {
 
     fn report(&self) -> SamplerReport {
         SamplerReport {
-            clusters: self.clustering.as_ref().map(|c| c.live() as u64),
-            cells: Some(self.grid.len() as u64),
-            rounds: Some(self.rounds),
+            clusters: self.state.clustering.as_ref().map(|c| c.live() as u64),
+            cells: Some(self.state.grid.len() as u64),
+            rounds: Some(self.state.rounds),
         }
     }
 }

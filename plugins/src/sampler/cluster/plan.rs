@@ -11,8 +11,8 @@ impl ClusterSampler {
     /// The fewest first-stage samples per pixel it can still end that stage at: the passes
     /// given and the one under way, or, once the stage is over, what it gave.
     pub(super) fn init_floor(&self) -> u32 {
-        match self.phase {
-            Phase::Init => self.init.cursor().floor(),
+        match self.state.phase {
+            Phase::Init => self.state.init.cursor().floor(),
             _ => self.settings.init_spp,
         }
     }
@@ -24,7 +24,7 @@ impl ClusterSampler {
     pub(super) fn plan_budget(&mut self, spp: u32, floor: u32) {
         let s = &self.settings;
         let spp = spp.clamp(1, s.spp);
-        if self.phase == Phase::Init {
+        if self.state.phase == Phase::Init {
             let lowest = if s.colour.is_some() { 2 } else { 1 };
             let share = if s.init_given {
                 s.init_spp
@@ -32,9 +32,9 @@ impl ClusterSampler {
                 first_stage_spp(spp, lowest)
             };
             let init = share.max(s.min_spp).max(floor).min(s.init_spp);
-            self.settings.init_spp = self.init.cursor_mut().shorten(init);
+            self.settings.init_spp = self.state.init.cursor_mut().shorten(init);
         }
         let planned = self.own_pixels() * u64::from(spp.saturating_sub(self.settings.init_spp));
-        self.remaining = planned.saturating_sub(self.given_adaptive);
+        self.state.remaining = planned.saturating_sub(self.state.given_adaptive);
     }
 }

@@ -2,6 +2,7 @@
 
 use super::super::tests::{space, ALL_DIMS};
 use super::*;
+use crate::cells::clusters::UNASSIGNED;
 use crate::registry::Choice;
 use crate::sampler::SamplerSetup;
 
@@ -20,10 +21,10 @@ fn planning_ahead_observes_every_round_before_the_partition_is_made() {
     let mut s = ClusterSampler::new(space(0, 0, 128, 96, ALL_DIMS[1]), settings, 3);
     let all = run(&mut s, field, None);
     assert_eq!(all.len(), 128 * 96 * 8);
-    assert!(s.in_flight.is_empty(), "a round was never observed");
-    assert!(s.rounds > 2, "{} rounds", s.rounds);
+    assert!(s.state.in_flight.is_empty(), "a round was never observed");
+    assert!(s.state.rounds > 2, "{} rounds", s.state.rounds);
     // The partition given is the one of the final clusters, made after the last round.
-    assert_eq!(s.partition(), s.make_partition().as_ref());
+    assert_eq!(s.partition(), s.state.make_partition(&s.space).as_ref());
 }
 
 /// Asks the cluster sampler for batches as the render loop does, watching the first stage.
@@ -45,12 +46,12 @@ impl Sampler for WatchFirstStage<'_> {
     }
 
     fn next_batch(&mut self, out: &mut Vec<SamplePoint>) -> bool {
-        let in_first_stage = self.s.phase == Phase::Init;
+        let in_first_stage = self.s.state.phase == Phase::Init;
         let more = self.s.next_batch(out);
-        if in_first_stage && self.s.clustering.is_some() && self.at_clustering.is_none() {
-            let counts = &self.s.sums.count;
+        if in_first_stage && self.s.state.clustering.is_some() && self.at_clustering.is_none() {
+            let counts = &self.s.state.sums.count;
             self.at_clustering = Some(counts.iter().map(|&n| u64::from(n)).sum());
-        } else if in_first_stage && self.s.phase == Phase::Init && self.s.plans_ahead() {
+        } else if in_first_stage && self.s.state.phase == Phase::Init && self.s.plans_ahead() {
             self.given_ahead += 1;
         }
         more
@@ -105,17 +106,23 @@ fn check_queue(s: &ClusterSampler) -> usize {
     };
     let mut seen = vec![0u32; clustering.clusters.len()];
     let mut checked = 0;
-    for e in s.queue.iter() {
-        if s.version[e.id as usize] != e.version {
+    for e in s.state.queue.iter() {
+        if s.state.version[e.id as usize] != e.version {
             continue;
         }
         seen[e.id as usize] += 1;
         let c = &clustering.clusters[e.id as usize];
-        let (p, now) = s.entry(e.id).expect("a current entry's cluster lives");
+        let (p, now) = s
+            .state
+            .entry(s.settings.priority, e.id)
+            .expect("a current entry's cluster lives");
         assert_eq!(e.cells as usize, c.cells.len());
         assert_eq!(e.samples, c.samples, "cluster {}", e.id);
         assert_eq!(e.weight.to_bits(), now.weight.to_bits());
-        assert_eq!(s.priority(e).to_bits(), p.to_bits());
+        assert_eq!(
+            state::priority(s.settings.priority, e).to_bits(),
+            p.to_bits()
+        );
         checked += 1;
     }
     for (id, c) in clustering.clusters.iter().enumerate() {
@@ -241,7 +248,7 @@ fn halting_in_the_first_stage_finishes_its_pass_and_stops() {
     let sp = space(0, 0, 40, 30, ALL_DIMS[1]);
     let mut s = ClusterSampler::new(sp, ClusterSettings::new(16), 2);
     let mut b = Vec::new();
-    while s.phase != Phase::Adaptive || s.rounds == 0 {
+    while s.state.phase != Phase::Adaptive || s.state.rounds == 0 {
         assert!(s.next_batch(&mut b));
         let r: Vec<[f32; 3]> = b.iter().map(field).collect();
         s.observe(&b, &r);
@@ -272,7 +279,7 @@ fn dropped_samples_count_against_the_budget_and_poison_nothing() {
     let kept: u64 = sums.count.iter().map(|&c| u64::from(c)).sum();
     assert!(kept > 0 && kept < pts.len() as u64);
     assert!(sums.lum.iter().all(|v| v.is_finite()));
-    assert!(s.squashed.iter().flatten().all(|v| v.is_finite()));
+    assert!(s.state.squashed.iter().flatten().all(|v| v.is_finite()));
 }
 
 #[test]

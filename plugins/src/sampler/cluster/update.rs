@@ -3,8 +3,10 @@
 //! cluster move. The unbiased pair's halves learn nothing after their first stage: for them it
 //! only queues the clusters a round sampled again, with their new counts.
 
-use super::ClusterSampler;
-use crate::cells::cell_features::{level, raw_gradient, raw_variance, Squashed};
+use super::scratch::{CellUpdate, Change, Scratch};
+use super::state::{priority, State};
+use super::Priority;
+use crate::cells::cell_features::{level, raw_gradient, raw_variance};
 use crate::cells::grid::MAX_DIMS;
 use crate::cells::queue::Queued;
 use rayon::prelude::*;
@@ -13,34 +15,24 @@ use rayon::prelude::*;
 /// [`crate::cells::Clustering::warm`]).
 const WARM_RUN: usize = 16;
 
-/// A cell whose feature changed in an update, with what the serial moves need of it.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Change {
-    cell: u32,
-    old: Squashed,
-    new: Squashed,
-    samples: u32,
-}
-
-/// What an update reads of a touched cell's own sums (an empty neighbour's: its level alone).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct CellUpdate {
-    level: f32,
-    variance: f32,
-    samples: u32,
-}
-
-impl ClusterSampler {
+impl State {
     /// Table 1's UpdateCluster after a round: new levels and features for the cells that got
-    /// samples and their face neighbours, then the cells that no longer fit move.
-    pub(super) fn update(&mut self, round_clusters: Vec<u32>) -> Vec<u32> {
+    /// samples (`scratch.touched`) and their face neighbours, then the cells that no longer fit
+    /// move; the clusters changed and those of the round, `round_clusters`, are queued again by
+    /// `rule`, and returned.
+    pub(super) fn update(
+        &mut self,
+        scratch: &mut Scratch,
+        rule: Priority,
+        round_clusters: Vec<u32>,
+    ) -> Vec<u32> {
         // The cells that got samples get new features; their neighbours' levels follow where
         // those are filled in from them (no samples of their own), but their features wait
         // until they are sampled: recomputing them too (table 1) cost 5 to 11 times as much
         // (one feature per face neighbour) for features that move by one cell's share.
-        let mut dirty = std::mem::take(&mut self.dirty);
+        let mut dirty = std::mem::take(&mut scratch.dirty);
         dirty.clear();
-        for (w, bits) in self.touched.iter_mut().enumerate() {
+        for (w, bits) in scratch.touched.iter_mut().enumerate() {
             while *bits != 0 {
                 dirty.push((w * 64) as u32 + bits.trailing_zeros());
                 *bits &= *bits - 1;
@@ -49,8 +41,8 @@ impl ClusterSampler {
         if dirty.is_empty() {
             // Nothing sampled is learnt (the unbiased pair's halves after their first stage):
             // the round's clusters are queued again, no more.
-            self.dirty = dirty;
-            return self.requeue(round_clusters);
+            scratch.dirty = dirty;
+            return self.requeue(&mut scratch.cluster_marks, rule, round_clusters);
         }
         let (grid, sums) = (&self.grid, &self.sums);
         let mut empty: Vec<u32> = Vec::new();
@@ -71,7 +63,7 @@ impl ClusterSampler {
         // Levels, and what else the features read of a touched cell's own sums, in one pass:
         // read again in the next pass, those sums had left the cache (a fifth of the features'
         // time at 700x700, by `perf annotate`).
-        let mut updates = std::mem::take(&mut self.cell_updates);
+        let mut updates = std::mem::take(&mut scratch.cell_updates);
         dirty
             .par_iter()
             .chain(empty.par_iter())
@@ -101,7 +93,7 @@ impl ClusterSampler {
         let squashed = &self.squashed;
         // New raw features, and the old and new feature vectors of the cells whose features changed,
         // made in parallel: the moves below are the only serial part.
-        let mut changes = std::mem::take(&mut self.changes);
+        let mut changes = std::mem::take(&mut scratch.changes);
         changes.clear();
         changes.par_extend(dirty.par_iter().zip(&updates).filter_map(|(&i, f)| {
             let i = i as usize;
@@ -116,7 +108,7 @@ impl ClusterSampler {
                 samples: f.samples,
             })
         }));
-        self.cell_updates = updates;
+        scratch.cell_updates = updates;
         let clustering = self.clustering.as_mut().expect("clustered");
         let mut changed: Vec<u32> = round_clusters;
         for run in changes.chunks(WARM_RUN) {
@@ -135,17 +127,17 @@ impl ClusterSampler {
                 changed.extend(b);
             }
         }
-        (self.dirty, self.changes) = (dirty, changes);
-        self.requeue(changed)
+        (scratch.dirty, scratch.changes) = (dirty, changes);
+        self.requeue(&mut scratch.cluster_marks, rule, changed)
     }
 
-    /// Queues the clusters `changed` again (each once, in the order of its first listing) with
-    /// new versions, so that their older entries go stale; returns them.
-    fn requeue(&mut self, mut changed: Vec<u32>) -> Vec<u32> {
-        let marks = &mut self.cluster_marks;
+    /// Queues the clusters `changed` again by `rule` (each once, in the order of its first
+    /// listing, found with the clear bits `marks`) with new versions, so that their older
+    /// entries go stale; returns them.
+    fn requeue(&mut self, marks: &mut Vec<u64>, rule: Priority, mut changed: Vec<u32>) -> Vec<u32> {
         first_listed(marks, &mut changed, |&id| id);
         self.renew(&mut changed);
-        self.push_all(changed.iter().copied());
+        self.push_all(rule, changed.iter().copied());
         changed
     }
 
@@ -155,20 +147,22 @@ impl ClusterSampler {
     /// each cluster's features (which cost a sixth of the sampler's time); the same entries.
     pub(super) fn requeue_picked(
         &mut self,
+        scratch: &mut Scratch,
+        rule: Priority,
         picked: &mut Vec<Queued>,
         mut ids: Vec<u32>,
     ) -> Vec<u32> {
-        first_listed(&mut self.cluster_marks, picked, |e| e.id);
+        first_listed(&mut scratch.cluster_marks, picked, |e| e.id);
         ids.clear();
         ids.extend(picked.iter().map(|e| e.id));
         if self.renew(&mut ids) {
-            self.push_all(ids.iter().copied());
+            self.push_all(rule, ids.iter().copied());
             return ids;
         }
         // The counts first, in a loop of independent reads whose cache misses overlap (read
         // while queueing, each missed in turn: two thirds of this function's time).
         let clustering = self.clustering.as_ref().expect("clustered");
-        let mut counts = std::mem::take(&mut self.counts);
+        let mut counts = std::mem::take(&mut scratch.counts);
         counts.clear();
         counts.extend(
             picked
@@ -181,9 +175,9 @@ impl ClusterSampler {
                 samples,
                 ..*e
             };
-            self.queue.push(self.priority(&e), e);
+            self.queue.push(priority(rule, &e), e);
         }
-        self.counts = counts;
+        scratch.counts = counts;
         ids
     }
 

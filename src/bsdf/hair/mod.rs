@@ -1,9 +1,9 @@
-//! pbrt-v3's hair material (materials/hair.{h,cpp}): Chiang et al.'s hair scattering model as
+//! pbrt-v3's hair BSDF (materials/hair.{h,cpp}): Chiang et al.'s hair scattering model as
 //! pbrt-v3 implements it ("The Implementation of a Hair Scattering Model", pbrt.org/hair.pdf),
-//! [`HairBsdf`], and the material that builds it at a hit, [`HairMaterial`].
+//! [`HairBsdf`]. The material that builds it at a hit is [`crate::material::hair`].
 //!
 //! The lobe works in the BSDF's local frame as pbrt-v3's does: x along the hair (the curve's
-//! dp/du, which [`crate::bsdf::Bsdf`] takes as its first axis), z the shading normal, so that
+//! dp/du, which the BSDF takes as its first axis), z the shading normal, so that
 //! `w.x` is sin theta (the angle to the plane normal to the hair) and atan2(w.z, w.y) is phi
 //! about the hair. The offset across the hair is h = -1 + 2 v, from the curve's v.
 //!
@@ -12,9 +12,8 @@
 //! aborts (h outside [-1, 1], beta outside [0, 1]), the inputs are clamped, and a NaN from a
 //! degenerate direction is left for the BSDF to turn into zero.
 
-use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
-use crate::texture::{FloatTexture, SpectrumTexture, Texture, TextureBuilder};
-use acr_parser::{Error, Loc, ParamList, Result};
+use super::fresnel::fr_dielectric;
+use crate::geometry::{Spectrum, Vec2, Vec3};
 use std::f32::consts::PI;
 
 /// pbrt-v3's `pMax`: the scattering orders modelled one by one (R, TT, TRT); the rest are
@@ -107,7 +106,7 @@ fn mp(cos_theta_i: f32, cos_theta_o: f32, sin_theta_i: f32, sin_theta_o: f32, v:
 fn ap(cos_theta_o: f32, eta: f32, h: f32, t: Spectrum) -> [Spectrum; P_MAX + 1] {
     let cos_gamma_o = safe_sqrt(1.0 - h * h);
     let cos_theta = cos_theta_o * cos_gamma_o;
-    let f = crate::bsdf::fr_dielectric(cos_theta, 1.0, eta);
+    let f = fr_dielectric(cos_theta, 1.0, eta);
     let mut a = [Spectrum::ZERO; P_MAX + 1];
     a[0] = Spectrum::splat(f);
     a[1] = sqr(1.0 - f) * t;
@@ -424,114 +423,6 @@ impl HairBsdf {
                 .to_array()
                 .map(|s| (-s.max(0.0).sqrt() * d).exp()),
         )
-    }
-}
-
-/// pbrt-v3's `HairMaterial`: the parameters, textured, from which a hit gets its [`HairBsdf`].
-/// Its absorption comes from `sigma_a` if given, else from `color`, else from the melanin
-/// concentrations (pbrt-v3's precedence; with none of them, eumelanin 1.3 as `sigma_a`).
-#[derive(Clone, Debug)]
-pub struct HairMaterial {
-    /// Absorption coefficient of the interior, per unit radius.
-    pub sigma_a: Option<SpectrumTexture>,
-    /// The colour the hair should look, turned into an absorption.
-    pub color: Option<SpectrumTexture>,
-    /// Eumelanin concentration (brown-black).
-    pub eumelanin: Option<FloatTexture>,
-    /// Pheomelanin concentration (red-yellow).
-    pub pheomelanin: Option<FloatTexture>,
-    /// Index of refraction of the interior (1.55).
-    pub eta: FloatTexture,
-    /// Longitudinal roughness in (0, 1] (0.3).
-    pub beta_m: FloatTexture,
-    /// Azimuthal roughness in (0, 1] (0.3).
-    pub beta_n: FloatTexture,
-    /// The scales' tilt in degrees (2).
-    pub alpha: FloatTexture,
-}
-
-impl HairMaterial {
-    /// pbrt-v3's `CreateHairMaterial`: its precedence among `sigma_a`, `color` and the melanins,
-    /// with its warnings for the ones ignored (at their location). A constant `beta_m` or
-    /// `beta_n` outside (0, 1] or `eta` below 1 is a located error: pbrt-v3 aborts on them.
-    pub fn from_params(t: &mut TextureBuilder<'_>, p: &ParamList, loc: &Loc) -> Result<Self> {
-        let mut sigma_a = t.spectrum_param_opt(p, "sigma_a")?;
-        let color = t.spectrum_param_opt(p, "color")?;
-        let eumelanin = t.float_param_opt(p, "eumelanin")?;
-        let pheomelanin = t.float_param_opt(p, "pheomelanin")?;
-        let used = if sigma_a.is_some() {
-            Some("\"sigma_a\"")
-        } else if color.is_some() {
-            Some("\"color\"")
-        } else if eumelanin.is_some() || pheomelanin.is_some() {
-            Some("\"eumelanin\"/\"pheomelanin\"")
-        } else {
-            None
-        };
-        if let Some(used) = used {
-            let given = [
-                ("sigma_a", sigma_a.is_some()),
-                ("color", color.is_some()),
-                ("eumelanin", eumelanin.is_some()),
-                ("pheomelanin", pheomelanin.is_some()),
-            ];
-            for (name, present) in given {
-                if present && !used.contains(&format!("\"{name}\"")) {
-                    let at = p.get(name).map_or_else(|| loc.clone(), |q| q.loc.clone());
-                    t.warn_once(
-                        format!("hair ignores {name} at {at}"),
-                        &at,
-                        format!("Ignoring \"{name}\" parameter since {used} was provided."),
-                    );
-                }
-            }
-        } else {
-            // pbrt-v3's default: brown-ish hair.
-            sigma_a = Some(Texture::Constant(sigma_a_from_concentration(1.3, 0.0)));
-        }
-        let mut float = |name: &str, default: f32, ok: fn(f32) -> bool, range: &str| {
-            let tex = t.float_param(p, name, default)?;
-            match tex.as_constant() {
-                Some(v) if !ok(v) => {
-                    let at = p.get(name).map_or_else(|| loc.clone(), |q| q.loc.clone());
-                    Err(Error::at(
-                        &at,
-                        format!("hair \"{name}\" {v} is not {range} (pbrt-v3 aborts on it)"),
-                    ))
-                }
-                _ => Ok(tex),
-            }
-        };
-        let beta_ok: fn(f32) -> bool = |v| v > 0.0 && v <= 1.0;
-        Ok(Self {
-            sigma_a,
-            color,
-            eumelanin,
-            pheomelanin,
-            eta: float("eta", 1.55, |v| v >= 1.0, "at least 1")?,
-            beta_m: float("beta_m", 0.3, beta_ok, "in (0, 1]")?,
-            beta_n: float("beta_n", 0.3, beta_ok, "in (0, 1]")?,
-            alpha: float("alpha", 2.0, f32::is_finite, "finite")?,
-        })
-    }
-
-    /// The lobe at a hit and the BSDF's relative index (pbrt-v3's
-    /// `HairMaterial::ComputeScatteringFunctions`): h = -1 + 2 v across the curve.
-    pub fn bxdf(&self, si: &SurfaceInteraction) -> (HairBsdf, f32) {
-        let bm = self.beta_m.eval(si);
-        let bn = self.beta_n.eval(si);
-        let a = self.alpha.eval(si);
-        let e = self.eta.eval(si);
-        let sig_a = if let Some(s) = &self.sigma_a {
-            s.eval(si).max(Spectrum::ZERO)
-        } else if let Some(c) = &self.color {
-            sigma_a_from_reflectance(c.eval(si).max(Spectrum::ZERO), bn)
-        } else {
-            let c = |t: &Option<FloatTexture>| t.as_ref().map_or(0.0, |t| t.eval(si)).max(0.0);
-            sigma_a_from_concentration(c(&self.eumelanin), c(&self.pheomelanin))
-        };
-        let h = -1.0 + 2.0 * si.uv.y;
-        (HairBsdf::new(h, e, sig_a, bm, bn, a), e)
     }
 }
 

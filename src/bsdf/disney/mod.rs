@@ -1,23 +1,17 @@
-//! pbrt-v3's `disney` material (materials/disney.{h,cpp}): Burley's 2015 Disney BSDF as pbrt-v3
-//! builds it, lobe for lobe and weight for weight, quirks included (each noted where it is).
-//!
-//! [`DisneyMaterial::add_lobes`] is pbrt-v3's `DisneyMaterial::ComputeScatteringFunctions`; the
-//! lobes pbrt-v3 defines in disney.cpp are [`DisneyBxdf`] (one [`Bxdf::Disney`] variant), and
-//! the two it borrows unchanged from core/reflection.cpp are the existing
-//! [`Bxdf::MicrofacetTransmission`] (the thin surface's) and [`Bxdf::LambertianTransmission`].
-//!
-//! Not supported: `scatterdistance` (pbrt-v3's `DisneyBSSRDF` subsurface scattering, which
-//! replaces the diffuse lobe by a smooth refraction into the object): acr has no BSSRDF, so a
-//! non-zero `scatterdistance` warns and the surface keeps pbrt-v3's diffuse lobe instead.
+//! The lobes of pbrt-v3's Disney BSDF (materials/disney.cpp): Burley's 2015 BSDF as pbrt-v3
+//! builds it, lobe for lobe, quirks included (each noted where it is). The material that adds
+//! them at a hit is [`crate::material::disney`]; the lobes pbrt-v3 defines in disney.cpp are
+//! [`DisneyBxdf`] (one `Bxdf::Disney` variant), and the two it borrows unchanged from
+//! core/reflection.cpp are the plain `Bxdf::MicrofacetTransmission` (the thin surface's) and
+//! `Bxdf::LambertianTransmission`.
 
-use crate::bsdf::{
-    fr_dielectric, reflect, sample_microfacet_reflection, Bsdf, Bxdf, BxdfType, LobeSample,
+use super::fresnel::{fr_dielectric, reflect};
+use super::lobe::{
+    finite_pdf, sample_microfacet_reflection, BxdfType, LobeSample, MicrofacetTransmission,
 };
-use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
+use crate::geometry::{Spectrum, Vec2, Vec3};
 use crate::microfacet::{abs_cos_theta, same_hemisphere, TrowbridgeReitz};
 use crate::sampling::cosine_sample_hemisphere;
-use crate::texture::{FloatTexture, SpectrumTexture, TextureBuilder};
-use acr_parser::{Loc, ParamList, Result};
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// pbrt-v3's `SchlickWeight`: (1 - cos θ)⁵, with 1 - cos θ clamped to [0, 1].
@@ -29,32 +23,14 @@ fn schlick_weight(cos_theta: f32) -> f32 {
 
 /// pbrt-v3's `Lerp(t, a, b)` = (1 - t) a + t b, for floats.
 #[inline]
-fn lerp(t: f32, a: f32, b: f32) -> f32 {
+pub(crate) fn lerp(t: f32, a: f32, b: f32) -> f32 {
     (1.0 - t) * a + t * b
 }
 
 /// pbrt-v3's `Lerp` for spectra.
 #[inline]
-fn lerp_s(t: f32, a: Spectrum, b: Spectrum) -> Spectrum {
+pub(crate) fn lerp_s(t: f32, a: Spectrum, b: Spectrum) -> Spectrum {
     (1.0 - t) * a + t * b
-}
-
-/// `std::max(a, b)` as C++ has it: `a` unless `a < b`, so a NaN `b` gives `a` (pbrt-v3's
-/// alphas of a NaN roughness become 0.001).
-#[inline]
-fn cpp_max(a: f32, b: f32) -> f32 {
-    if a < b {
-        b
-    } else {
-        a
-    }
-}
-
-/// pbrt-v3's `SchlickR0FromEta`: normal-incidence reflectance of a dielectric seen from air.
-#[inline]
-fn schlick_r0_from_eta(eta: f32) -> f32 {
-    let (a, b) = (eta - 1.0, eta + 1.0);
-    (a * a) / (b * b)
 }
 
 /// pbrt-v3's `GTR1`, the clearcoat's distribution of normals (fatter tails than GGX).
@@ -168,10 +144,14 @@ impl DisneyBxdf {
     }
 
     /// The same transmission with Trowbridge-Reitz's own masking-shadowing: pbrt-v3's
-    /// `MicrofacetTransmission`, which acr's [`Bxdf::MicrofacetTransmission`] is.
+    /// `MicrofacetTransmission`, which acr's `Bxdf::MicrofacetTransmission` is.
     #[inline]
-    fn smith_transmission(t: Spectrum, distribution: TrowbridgeReitz, eta: f32) -> Bxdf {
-        Bxdf::MicrofacetTransmission {
+    fn smith_transmission(
+        t: Spectrum,
+        distribution: TrowbridgeReitz,
+        eta: f32,
+    ) -> MicrofacetTransmission {
+        MicrofacetTransmission {
             t,
             distribution,
             eta_a: 1.0,
@@ -374,11 +354,7 @@ impl DisneyBxdf {
                 eta,
             } => Self::smith_transmission(t, distribution, eta).pdf(wo, wi),
         };
-        if p.is_finite() && p > 0.0 {
-            p
-        } else {
-            0.0
-        }
+        finite_pdf(p)
     }
 
     /// The lobe's nominal reflectance or transmittance for first-hit features: R for the
@@ -405,186 +381,6 @@ fn disney_fresnel(r0: Spectrum, metallic: f32, eta: f32, cos_i: f32) -> Spectrum
     let dielectric = Spectrum::splat(fr_dielectric(cos_i, 1.0, eta));
     let schlick = lerp_s(schlick_weight(cos_i), r0, Spectrum::ONE);
     lerp_s(metallic, dielectric, schlick)
-}
-
-/// pbrt-v3's `disney` material's parameters, possibly textured (defaults as its
-/// `CreateDisneyMaterial`).
-#[derive(Clone, Debug)]
-pub struct DisneyMaterial {
-    /// Base colour (0.5).
-    pub color: SpectrumTexture,
-    /// Metallic weight (0).
-    pub metallic: FloatTexture,
-    /// Index of refraction (1.5).
-    pub eta: FloatTexture,
-    /// Roughness, squared into the alphas (0.5).
-    pub roughness: FloatTexture,
-    /// Tint of the specular reflectance toward the colour's hue (0).
-    pub specular_tint: FloatTexture,
-    /// Anisotropy: alphas r² / aspect and r² aspect with aspect = sqrt(1 - 0.9 a) (0).
-    pub anisotropic: FloatTexture,
-    /// Sheen weight (0).
-    pub sheen: FloatTexture,
-    /// Tint of the sheen toward the colour's hue (0.5).
-    pub sheen_tint: FloatTexture,
-    /// Clearcoat weight (0).
-    pub clearcoat: FloatTexture,
-    /// Clearcoat glossiness (1).
-    pub clearcoat_gloss: FloatTexture,
-    /// Specular transmission weight (0).
-    pub spec_trans: FloatTexture,
-    /// A thin surface: diffuse and fake-subsurface blend, diffuse transmission (false).
-    pub thin: bool,
-    /// Thin surfaces: share of the diffuse given to the fake subsurface lobe (0).
-    pub flatness: FloatTexture,
-    /// Thin surfaces: diffuse transmission, halved by pbrt-v3 (1).
-    pub diff_trans: FloatTexture,
-}
-
-impl DisneyMaterial {
-    /// The material from its parameters, as pbrt-v3's `CreateDisneyMaterial` (`bumpmap` is the
-    /// material builder's); a non-zero `scatterdistance` warns (no subsurface scattering).
-    pub fn from_params(t: &mut TextureBuilder, p: &ParamList, loc: &Loc) -> Result<Self> {
-        let sd = t.spectrum_param_opt(p, "scatterdistance")?;
-        if sd.is_some_and(|sd| sd.as_constant() != Some(Spectrum::ZERO)) {
-            t.warn_once(
-                "disney scatterdistance",
-                loc,
-                "disney \"scatterdistance\" (subsurface scattering) is not supported; \
-                 the diffuse lobe is used",
-            );
-        }
-        Ok(Self {
-            color: t.spectrum_param(p, "color", Spectrum::splat(0.5))?,
-            metallic: t.float_param(p, "metallic", 0.0)?,
-            eta: t.float_param(p, "eta", 1.5)?,
-            roughness: t.float_param(p, "roughness", 0.5)?,
-            specular_tint: t.float_param(p, "speculartint", 0.0)?,
-            anisotropic: t.float_param(p, "anisotropic", 0.0)?,
-            sheen: t.float_param(p, "sheen", 0.0)?,
-            sheen_tint: t.float_param(p, "sheentint", 0.5)?,
-            clearcoat: t.float_param(p, "clearcoat", 0.0)?,
-            clearcoat_gloss: t.float_param(p, "clearcoatgloss", 1.0)?,
-            spec_trans: t.float_param(p, "spectrans", 0.0)?,
-            thin: p.bool_or("thin", false)?,
-            flatness: t.float_param(p, "flatness", 0.0)?,
-            diff_trans: t.float_param(p, "difftrans", 1.0)?,
-        })
-    }
-
-    /// Adds the lobes pbrt-v3's `DisneyMaterial::ComputeScatteringFunctions` adds, each weighted
-    /// by `scale`. Lobes of zero weight are added too, as pbrt-v3 does: the lobe count decides
-    /// the sampling probabilities.
-    pub fn add_lobes(&self, si: &SurfaceInteraction, b: &mut Bsdf, scale: Spectrum) {
-        let mut add = |x: Bxdf| {
-            b.add_scaled(x, scale);
-        };
-        let c = self.color.eval(si).max(Spectrum::ZERO);
-        let metallic = self.metallic.eval(si);
-        let e = self.eta.eval(si);
-        let strans = self.spec_trans.eval(si);
-        let diffuse_weight = (1.0 - metallic) * (1.0 - strans);
-        // 0: all the diffuse is reflected; 1: half of it transmitted (pbrt-v3 halves it).
-        let dt = self.diff_trans.eval(si) / 2.0;
-        let rough = self.roughness.eval(si);
-        let lum = crate::spectrum_luminance(c);
-        // The colour's hue and saturation.
-        let c_tint = if lum > 0.0 { c / lum } else { Spectrum::ONE };
-        let sheen = self.sheen.eval(si);
-        let c_sheen = if sheen > 0.0 {
-            lerp_s(self.sheen_tint.eval(si), Spectrum::ONE, c_tint)
-        } else {
-            Spectrum::ZERO
-        };
-
-        if diffuse_weight > 0.0 {
-            if self.thin {
-                // Diffuse and fake subsurface blended by flatness, both weighted by 1 - dt.
-                let flat = self.flatness.eval(si);
-                add(Bxdf::Disney(DisneyBxdf::Diffuse {
-                    r: diffuse_weight * (1.0 - flat) * (1.0 - dt) * c,
-                }));
-                add(Bxdf::Disney(DisneyBxdf::FakeSs {
-                    r: diffuse_weight * flat * (1.0 - dt) * c,
-                    roughness: rough,
-                }));
-            } else {
-                // pbrt-v3 swaps this for a refraction and its BSSRDF when scatterdistance is
-                // not black: not supported (a warning at build time).
-                add(Bxdf::Disney(DisneyBxdf::Diffuse {
-                    r: diffuse_weight * c,
-                }));
-            }
-            // A pbrt-v3 quirk: the retro-reflection is not weighted by 1 - dt on thin surfaces.
-            add(Bxdf::Disney(DisneyBxdf::Retro {
-                r: diffuse_weight * c,
-                roughness: rough,
-            }));
-            if sheen > 0.0 {
-                add(Bxdf::Disney(DisneyBxdf::Sheen {
-                    r: diffuse_weight * sheen * c_sheen,
-                }));
-            }
-        }
-
-        // Roughness is squared, not remapped, into the alphas.
-        let aspect = (1.0 - self.anisotropic.eval(si) * 0.9).sqrt();
-        let alphas = |r: f32| {
-            TrowbridgeReitz::new(
-                cpp_max(0.001, r * r / aspect),
-                cpp_max(0.001, r * r * aspect),
-            )
-        };
-        let distribution = alphas(rough);
-        let spec_tint = self.specular_tint.eval(si);
-        let r0 = lerp_s(
-            metallic,
-            schlick_r0_from_eta(e) * lerp_s(spec_tint, Spectrum::ONE, c_tint),
-            c,
-        );
-        add(Bxdf::Disney(DisneyBxdf::Specular {
-            distribution,
-            r0,
-            metallic,
-            eta: e,
-        }));
-
-        let cc = self.clearcoat.eval(si);
-        if cc > 0.0 {
-            add(Bxdf::Disney(DisneyBxdf::Clearcoat {
-                weight: cc,
-                gloss: lerp(self.clearcoat_gloss.eval(si), 0.1, 0.001),
-            }));
-        }
-
-        if strans > 0.0 {
-            // Scaled by sqrt(colour), so that two refractions give the colour back.
-            let t = strans * c.map(f32::sqrt);
-            if self.thin {
-                // Roughness scaled by the index (Burley 2015, figure 15), and, unlike the
-                // reflection, Trowbridge-Reitz's own masking-shadowing. A thin surface still
-                // refracts with `eta` in pbrt-v3.
-                let rscaled = (0.65 * e - 0.35) * rough;
-                add(Bxdf::MicrofacetTransmission {
-                    t,
-                    distribution: alphas(rscaled),
-                    eta_a: 1.0,
-                    eta_b: e,
-                });
-            } else {
-                add(Bxdf::Disney(DisneyBxdf::Transmission {
-                    t,
-                    distribution,
-                    eta: e,
-                }));
-            }
-        }
-        if self.thin {
-            // pbrt-v3's comment says "weighted by (1 - diffTrans)"; it is weighted by dt, and
-            // added even where the diffuse weight is zero (a thin metal transmits diffusely).
-            add(Bxdf::LambertianTransmission { t: dt * c });
-        }
-    }
 }
 
 #[cfg(test)]

@@ -1,7 +1,10 @@
-//! Tests of the Disney BSDF against pbrt-v3's values, energy and sampling.
+//! Tests of the Disney BSDF against pbrt-v3's values, energy and sampling, its lobes built by
+//! the `disney` material from scene text as pbrt-v3 builds them.
 
 use super::*;
 use crate::bsdf::check::*;
+use crate::bsdf::{Bsdf, Bxdf};
+use crate::geometry::SurfaceInteraction;
 use crate::material::{build_materials, Material};
 use crate::sampling::uniform_sample_sphere;
 use acr_parser::parse_str;
@@ -72,7 +75,7 @@ fn pbrt_name(b: &Bxdf) -> &'static str {
 /// surface), and the same samples for 12 sample values from each of 7 directions.
 #[test]
 fn bsdf_matches_pbrt_v3() {
-    let data = include_str!("../../tests/data/pbrt-v3/disney-bsdf.txt");
+    let data = include_str!("../../../tests/data/pbrt-v3/disney-bsdf.txt");
     let num = |w: &[&str], i: usize| -> f32 { w[i].parse().unwrap() };
     let v3 = |w: &[&str], i: usize| Vec3::new(num(w, i), num(w, i + 1), num(w, i + 2));
     let mut si = flat_hit();
@@ -160,7 +163,7 @@ fn bsdf_matches_pbrt_v3() {
                 let reflect = s.wi.dot(si.n) * dirs[o].dot(si.n) > 0.0;
                 let lobe_kind = b.lobes()[comp].bxdf.kind();
                 if n == 1 && !reflect && !lobe_kind.contains(BxdfType::TRANSMISSION) {
-                    // A known difference (src/bsdf.rs): with one lobe pbrt-v3 keeps the
+                    // A known difference (src/bsdf/mod.rs): with one lobe pbrt-v3 keeps the
                     // lobe's value below the geometric surface; acr applies its test.
                     assert_eq!(s.f, Spectrum::ZERO, "{line}");
                     one_lobe_below += 1;
@@ -309,7 +312,7 @@ fn sampling_agrees_with_evaluation() {
             });
             if transmits && wo.z.abs() < 0.2 {
                 // pbrt-v3's rough transmission pdf also counts microfacets facing away from
-                // a grazing wo, which its sampler never picks (see src/bsdf.rs's tests).
+                // a grazing wo, which its sampler never picks (see src/bsdf/tests.rs).
                 assert!(
                     integral < 1.1 && integral + 4.0 * se + 0.01 > success,
                     "{p} {wo}"

@@ -1,11 +1,14 @@
-//! Tests of the hair BSDF and material against pbrt-v3's values and its own hair tests.
+//! Tests of the hair BSDF and material against pbrt-v3's values and its own hair tests. The
+//! material's tests are here too: they read the lobe it builds, down to its private fields.
 
 use super::*;
 use crate::bsdf::check::Rng;
 use crate::bsdf::{Bsdf, Bxdf};
-use crate::material::{build_materials, Material};
+use crate::geometry::SurfaceInteraction;
+use crate::material::{build_materials, HairMaterial, Material};
 use crate::sampling::uniform_sample_sphere;
-use acr_parser::{parse_str, Warning};
+use crate::texture::Texture;
+use acr_parser::{parse_str, Error, Result, Warning};
 use std::path::Path;
 
 /// 1 / (4 pi), pbrt-v3's `UniformSpherePdf`.
@@ -20,7 +23,7 @@ const UNIFORM_SPHERE_PDF: f32 = std::f32::consts::FRAC_1_PI / 4.0;
 /// up to 2.4e-4 apart in the sharpest lobes.)
 #[test]
 fn values_match_pbrt_v3() {
-    let data = include_str!("../../tests/data/pbrt-v3/hair-values.txt");
+    let data = include_str!("../../../tests/data/pbrt-v3/hair-values.txt");
     let mut hair = None;
     let mut counts = [0usize; 6];
     // Largest relative differences seen: f, pdf, sampled direction (absolute).

@@ -2,6 +2,9 @@
 //! allocation: a [`Bsdf`] holds up to [`MAX_LOBES`] lobes by value, each a [`Bxdf`] enum with an
 //! RGB scale (pbrt-v3's `ScaledBxDF`, used by the mix material).
 //!
+//! The lobes of pbrt-v3's Disney BSDF and of its hair are in [`disney`] and [`hair`]; what
+//! every lobe shares (its kind, its sample, the microfacet steps) is a leaf below them all.
+//!
 //! Lobes work in the local shading frame (z = shading normal); [`Bsdf`] converts from world
 //! space and decides reflection against transmission with the geometric normal, as pbrt-v3 does.
 //! Where pbrt-v3 would produce NaN or infinity (grazing or degenerate directions), these return
@@ -10,11 +13,14 @@
 use crate::geometry::{Frame, Spectrum, SurfaceInteraction, Vec2, Vec3};
 
 mod bxdf;
+pub mod disney;
 mod fresnel;
+pub mod hair;
+mod lobe;
 
-pub(crate) use bxdf::sample_microfacet_reflection;
-pub use bxdf::{Bxdf, BxdfType, LobeSample};
+pub use bxdf::Bxdf;
 pub use fresnel::{fr_conductor, fr_dielectric, reflect, refract, Fresnel};
+pub use lobe::{BxdfType, LobeSample};
 /// The most lobes a BSDF holds (pbrt-v3's `MaxBxDFs`).
 pub const MAX_LOBES: usize = 8;
 
