@@ -4,8 +4,8 @@
 //! [`super::scratch::Scratch`].
 
 use super::Priority;
-use crate::cells::clusters::UNASSIGNED;
 use crate::cells::cell_features::Squashed;
+use crate::cells::clusters::UNASSIGNED;
 use crate::cells::grid::MAX_DIMS;
 use crate::cells::queue::{BucketQueue, Queued};
 use crate::cells::{CellGrid, CellSums, Clustering, FeatureScale};
