@@ -2,15 +2,70 @@
 //! parameters area lights share with them.
 
 use super::Builder;
+use crate::accel::Accel;
 use crate::geometry::{Spectrum, Vec3};
 use crate::image_io::RgbImage;
-use crate::light::{spot_frame, EnvMap, Light};
+use crate::light::{prim_area, spot_frame, AreaShape, EnvMap, Light};
 use crate::light_image::LightImage;
 use acr_parser::{Error, ParamList, ParamType, PluginDesc, Result};
 use glam::DMat4;
 use std::path::Path;
 
 impl Builder<'_> {
+    /// The area lights of the world's shapes, one per primitive of positive area that emits,
+    /// each attached to its primitive's surface (`accel` placed, so that areas are final).
+    pub(super) fn add_area_lights(&mut self, accel: &Accel) -> Result<()> {
+        for (light, kind, surface) in std::mem::take(&mut self.area_lights) {
+            if !matches!(light.kind.as_str(), "area" | "diffuse") {
+                return Err(Error::at(
+                    &light.loc,
+                    format!(
+                        "area light \"{}\" is not supported (only \"diffuse\")",
+                        light.kind
+                    ),
+                ));
+            }
+            let params = &light.params;
+            let l_emit =
+                rgb_param(params, "L", Spectrum::ONE)? * rgb_param(params, "scale", Spectrum::ONE)?;
+            let two_sided = params.bool_or("twosided", false)?;
+            let samples = light_sample_count(params)?;
+            let area = prim_area(&accel.world, kind);
+            if area > 0.0 && l_emit.max_element() > 0.0 {
+                self.lights.push(Light::Area {
+                    shape: AreaShape { kind },
+                    l_emit,
+                    two_sided,
+                    area,
+                });
+                self.light_samples.push(samples);
+                self.surfaces[surface as usize].area_light = Some((self.lights.len() - 1) as u32);
+            }
+        }
+        Ok(())
+    }
+
+    /// The `LightSource` lights, in render space, with their shadow sample counts; an infinite
+    /// light surrounds a world of radius `world_radius`.
+    pub(super) fn add_lights(&mut self, world_radius: f32, main_dir: &Path) -> Result<()> {
+        let desc = self.desc;
+        for l in &desc.lights {
+            let world_from_light = self.render_from_world * l.world_from_light;
+            let Some(light) = self.light(&l.plugin, &world_from_light, world_radius, main_dir)?
+            else {
+                continue;
+            };
+            let samples = match light {
+                Light::Infinite { .. } => light_sample_count(&l.plugin.params)?,
+                _ => 1,
+            };
+            self.lights.push(light);
+            self.light_samples.push(samples);
+        }
+        Ok(())
+    }
+
+    /// One `LightSource` light, or `None` when it is skipped.
     pub(super) fn light(
         &mut self,
         p: &PluginDesc,
@@ -134,7 +189,7 @@ const MAX_LIGHT_SAMPLES: i32 = 4096;
 /// An area or infinite light's shadow samples per shading point: pbrt-v3's
 /// `FindOneInt("samples", FindOneInt("nsamples", 1))`; below 1 counts as 1 (pbrt-v3 then takes
 /// one sample), above [`MAX_LIGHT_SAMPLES`] is an error at the parameter.
-pub(super) fn light_sample_count(params: &ParamList) -> Result<u32> {
+fn light_sample_count(params: &ParamList) -> Result<u32> {
     let nsamples = params.int_or("nsamples", 1)?;
     let n = params.int_or("samples", nsamples)?;
     if n > MAX_LIGHT_SAMPLES {
