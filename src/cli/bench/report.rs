@@ -1,6 +1,32 @@
 //! What a bench writes: the CSVs, the Markdown report and the plots.
 
-use super::*;
+use super::{file_safe, BenchOptions, CostRow, Manifest, Measured, Method, Mode, Row};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Writes what a bench of manifest `m` measured into `opts.out`: the CSVs, a plot per scene
+/// (a failed plot is only a warning) and the Markdown report.
+pub(super) fn write_results(
+    m: &Manifest,
+    manifest_path: &Path,
+    opts: &BenchOptions,
+    rows: &[Row],
+    costs: &[CostRow],
+) -> Result<(), String> {
+    write_csv(&opts.out.join("results.csv"), rows)?;
+    if m.sampler_cost.is_some() {
+        write_cost_csv(&opts.out.join("sampler_cost.csv"), costs)?;
+    }
+    for scene in &m.scenes {
+        let path = opts.out.join(format!("{}.png", file_safe(&scene.name)));
+        if let Err(e) = plot_scene(&path, &scene.name, &m.methods, rows) {
+            eprintln!("{}: plot failed: {e}", path.display());
+        }
+    }
+    let report = report_markdown(m, manifest_path, opts, rows, costs);
+    let path = opts.out.join("report.md");
+    std::fs::write(&path, report).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
 
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -218,6 +244,28 @@ pub fn report_markdown(
         s.push('\n');
     }
     s
+}
+
+fn available_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The CPU model and core count, from /proc/cpuinfo where there is one.
+fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_owned())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_owned());
+    format!(
+        "{model}, {} hardware threads, {}",
+        available_threads(),
+        std::env::consts::OS
+    )
 }
 
 fn ratio(x: f64, base: Option<f64>) -> String {
