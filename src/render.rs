@@ -386,8 +386,11 @@ pub fn render_with(
 
 /// Traces batches of sample points: camera rays and the estimator's radiance.
 struct Tracer<'s, 'e> {
+    /// The scene and its camera.
     scene: &'s Scene,
+    /// What each sample estimates.
     li: &'s Estimator<'e>,
+    /// The render's seed.
     seed: u64,
     /// The sampler's streams (at least 1), each drawing the integrator's decisions from
     /// sequences of its own.
@@ -438,7 +441,9 @@ impl Tracer<'_, '_> {
 
 /// A render's [`Stop`] rules and what they keep between batches.
 struct Watch<'s, 'a> {
+    /// The rules.
     stop: &'s Stop<'a>,
+    /// When the render started.
     start: Instant,
     /// The pixels rendered (at least 1).
     pixels: u64,

@@ -243,12 +243,14 @@ impl<'a> Builder<'a> {
 }
 
 impl Builder<'_> {
+    /// Warns at `loc`, once per `key`.
     fn warn_once(&mut self, key: String, loc: &acr_parser::Loc, msg: String) {
         if self.warned.insert(key) {
             self.warnings.push(Warning::at(loc, msg));
         }
     }
 
+    /// Adds surface `s`; its index.
     fn surface(&mut self, s: Surface) -> u32 {
         self.surfaces.push(s);
         (self.surfaces.len() - 1) as u32

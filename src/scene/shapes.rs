@@ -410,6 +410,7 @@ impl Builder<'_> {
 
 /// The primitives a shape made, and whether they may carry its area light.
 struct Made {
+    /// The primitives.
     prims: Vec<PrimKind>,
     /// False for shapes pbrt-v3 cannot sample: their area light is dropped.
     can_emit: bool,

@@ -10,9 +10,13 @@ use std::process::Command;
 
 /// What `acr render` reported of one run.
 pub(super) struct RunOutput {
+    /// Render plus reconstruction seconds.
     pub(super) seconds: f64,
+    /// Samples traced.
     pub(super) samples: u64,
+    /// Pixels of the image.
     pub(super) pixels: u64,
+    /// Peak resident memory.
     pub(super) peak_rss_mb: f64,
     /// With `--sampler-cost`: what it measured.
     pub(super) cost: Option<SamplerCost>,

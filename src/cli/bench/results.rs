@@ -64,10 +64,13 @@ pub struct SamplerCost {
 /// A sampler-cost measure over its runs.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct CostSummary {
+    /// How many runs.
     pub(super) runs: usize,
     /// The median share.
     pub(super) share: f64,
+    /// The least share.
     pub(super) least: f64,
+    /// The largest share.
     pub(super) largest: f64,
     /// The median seconds of a render by a fresh sampler.
     pub(super) rerender: f64,

@@ -33,24 +33,31 @@ pub fn run_bench(manifest_path: &Path, opts: &BenchOptions) -> Result<BenchResul
 
 /// A bench under way: what every run shares, and how many rows are done.
 struct Bench<'a> {
+    /// The manifest.
     m: &'a Manifest,
     /// The manifest's folder, which its paths are relative to.
     base: &'a Path,
     /// Where the runs' images and stats go.
     runs_dir: &'a Path,
+    /// The executable and the output folder.
     opts: &'a BenchOptions,
     /// The seeds each row averages over.
     seeds: Vec<u64>,
-    /// Rows in all, and done so far, for the progress lines.
+    /// Rows in all, for the progress lines.
     total: usize,
+    /// Rows done so far.
     done: usize,
 }
 
 /// One method on one scene at one budget: what its rows share.
 struct Cell<'a> {
+    /// The scene.
     scene: &'a SceneEntry,
+    /// Its file.
     scene_path: &'a Path,
+    /// The method.
     method: &'a Method,
+    /// The budget.
     spp: u32,
     /// Whether it is the first method, whose times are the equal-time limits.
     first: bool,

@@ -21,12 +21,19 @@ use target::Target;
 
 /// When each step of a render ended, for the stats' seconds.
 struct Clock {
+    /// The command began.
     start: Instant,
+    /// The scene files parsed.
     parsed: Instant,
+    /// The scene built, its plugins chosen, its outputs planned.
     built: Instant,
+    /// The render loop done.
     rendered: Instant,
+    /// `--sampler-cost` measured.
     measured: Instant,
+    /// The image reconstructed from the film.
     reconstructed: Instant,
+    /// The image and AOVs written.
     written: Instant,
 }
 

@@ -100,7 +100,9 @@ pub(super) fn render_scene(
 /// What looks at the image as it renders: the partial images written to the output, the
 /// viewer it is shown in.
 struct Looks<'t> {
+    /// The output the partial images go to.
     out: &'t Output,
+    /// The viewer (`--display-server`), if it answered.
     display: Option<Display>,
 }
 

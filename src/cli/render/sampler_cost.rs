@@ -27,10 +27,15 @@ pub(super) struct SamplerCost {
 
 /// What `--sampler-cost` needs to render the scene again, and the first render's film.
 pub(super) struct SamplerCostRun<'a> {
+    /// The scene as parsed, to choose its plugins again.
     pub(super) desc: &'a SceneDescription,
+    /// The scene built.
     pub(super) scene: &'a Scene,
+    /// The command line's choices of plugins.
     pub(super) overrides: &'a Overrides,
+    /// The command line (its spp and seed).
     pub(super) args: &'a RenderArgs,
+    /// The first render's film, which every image must equal.
     pub(super) film: &'a Film,
 }
 
