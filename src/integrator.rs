@@ -7,7 +7,7 @@
 //! expectation, one ray fewer per bounce.
 
 use crate::first_hit::{FirstHit, FirstHitProbe};
-use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
+use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction, Vec3};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::sampling::power_heuristic;
@@ -252,6 +252,75 @@ fn sample_light(
     }
 }
 
+/// The path's last scattering, as the MIS weight of the emission its next ray finds needs it.
+#[derive(Clone, Copy)]
+struct LastScatter {
+    /// Whether the next ray is the camera ray or leaves a specular bounce: no light sample
+    /// could have found what it finds, so its emission counts whole.
+    whole: bool,
+    /// The scattering point.
+    p: Vec3,
+    /// The BSDF density of the direction taken from it.
+    bsdf_pdf: f32,
+    /// Where the light for next-event estimation was chosen there (`None`: none was).
+    ctx: Option<LightContext>,
+}
+
+impl LastScatter {
+    /// Emission `le` of light `light` found by the path of throughput `beta`, weighted against
+    /// the light sample at the last scattering, whose density of it `pdf_of_light` gives
+    /// (times the chance of choosing the light).
+    fn weigh(
+        &self,
+        scene: &Scene,
+        strategy: LightStrategy,
+        light: usize,
+        beta: Spectrum,
+        le: Spectrum,
+        pdf_of_light: impl FnOnce() -> f32,
+    ) -> Spectrum {
+        if self.whole {
+            return beta * le;
+        }
+        let choice = self
+            .ctx
+            .map_or(0.0, |ctx| scene.light_choice_pdf(strategy, ctx, light));
+        let light_pdf = choice * pdf_of_light();
+        beta * le * power_heuristic(1.0, self.bsdf_pdf, 1.0, light_pdf)
+    }
+}
+
+/// Next-event estimation at `si` for the lights chosen at `ctx`: a light's sampled direct
+/// radiance; `None` when no light can reach the point (its sample's dimensions are spent all
+/// the same, so that later decisions keep their place in the stream).
+fn next_event(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &crate::bsdf::Bsdf,
+    ctx: LightContext,
+    strategy: LightStrategy,
+    stream: &mut SampleStream,
+    rays: &mut u32,
+) -> Option<Spectrum> {
+    match scene.choose_light(strategy, ctx, stream.next_1d()) {
+        Some((light_index, choice_pdf)) => Some(sample_light(
+            scene,
+            si,
+            bsdf,
+            light_index as u32,
+            choice_pdf,
+            stream,
+            rays,
+        )),
+        None => {
+            stream.next_2d();
+            None
+        }
+    }
+}
+
+/// The path integrator's estimate of the radiance along `ray`: at each scattering a light
+/// sample and a BSDF sample, emission found weighted by MIS, Russian roulette after depth 3.
 fn path_li(
     scene: &Scene,
     mut ray: Ray,
@@ -265,14 +334,13 @@ fn path_li(
     let mut beta = Spectrum::ONE;
     let mut rays = 0u32;
     let mut depth = 0u32;
-    let mut specular_bounce = false;
     let mut eta_scale = 1.0f32;
-    // The previous scattering point and the BSDF density of the direction taken from it.
-    let mut prev_p = ray.o;
-    let mut prev_bsdf_pdf = 0.0f32;
-    // Where the light for next-event estimation was chosen at the previous scattering point,
-    // for the MIS weight of emission that the BSDF sample finds (`None`: none was chosen).
-    let mut prev_ctx: Option<LightContext> = None;
+    let mut last = LastScatter {
+        whole: true,
+        p: ray.o,
+        bsdf_pdf: 0.0,
+        ctx: None,
+    };
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
     let mut probe = FirstHitProbe::default();
@@ -282,15 +350,9 @@ fn path_li(
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
-                if depth == 0 || specular_bounce {
-                    l += beta * le;
-                } else {
-                    let choice = prev_ctx.map_or(0.0, |ctx| {
-                        scene.light_choice_pdf(light_strategy, ctx, i as usize)
-                    });
-                    let light_pdf = choice * light.pdf_le(ray.d.normalize());
-                    l += beta * le * power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
-                }
+                l += last.weigh(scene, light_strategy, i as usize, beta, le, || {
+                    light.pdf_le(ray.d.normalize())
+                });
             }
             break;
         };
@@ -305,16 +367,9 @@ fn path_li(
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
             if le != Spectrum::ZERO {
-                if depth == 0 || specular_bounce {
-                    l += beta * le;
-                } else {
-                    let choice = prev_ctx.map_or(0.0, |ctx| {
-                        scene.light_choice_pdf(light_strategy, ctx, li as usize)
-                    });
-                    let light_pdf =
-                        choice * light.pdf_area_hit(&scene.accel.world, prev_p, si.p, si.n);
-                    l += beta * le * power_heuristic(1.0, prev_bsdf_pdf, 1.0, light_pdf);
-                }
+                l += last.weigh(scene, light_strategy, li as usize, beta, le, || {
+                    light.pdf_area_hit(&scene.accel.world, last.p, si.p, si.n)
+                });
             }
         }
         let Some(material) = hit.surface.material else {
@@ -333,31 +388,16 @@ fn path_li(
         let si = material.shading(&si);
         let bsdf = material.bsdf(&si);
         probe.surface(&si, &bsdf);
-        prev_ctx = None;
+        last.ctx = None;
         if have_lights && bsdf.has_non_specular() {
             let ctx = LightContext {
                 p: si.p,
                 n: si.shading_n,
             };
-            prev_ctx = Some(ctx);
-            match scene.choose_light(light_strategy, ctx, stream.next_1d()) {
-                Some((light_index, choice_pdf)) => {
-                    l += beta
-                        * sample_light(
-                            scene,
-                            &si,
-                            &bsdf,
-                            light_index as u32,
-                            choice_pdf,
-                            stream,
-                            &mut rays,
-                        );
-                }
-                // No light can reach the point: the light sample's dimensions are spent all
-                // the same, so that later decisions keep their place in the stream.
-                None => {
-                    stream.next_2d();
-                }
+            last.ctx = Some(ctx);
+            let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
+            if let Some(direct) = direct {
+                l += beta * direct;
             }
         }
         let u_lobe = stream.next_1d();
@@ -372,7 +412,6 @@ fn path_li(
         if !crate::geometry::is_valid_radiance(beta) {
             break;
         }
-        specular_bounce = s.specular;
         let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
         if s.specular && transmitted {
             let eta = bsdf.eta();
@@ -382,8 +421,9 @@ fn path_li(
                 1.0 / (eta * eta)
             };
         }
-        prev_p = si.p;
-        prev_bsdf_pdf = if s.specular { 0.0 } else { s.pdf };
+        last.whole = s.specular;
+        last.p = si.p;
+        last.bsdf_pdf = if s.specular { 0.0 } else { s.pdf };
         ray = si.spawn_ray(s.wi);
         depth += 1;
         let rr_beta = beta * eta_scale;

@@ -310,9 +310,8 @@ pub fn render_with(
     progress: Option<&indicatif::ProgressBar>,
     mut features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
-    let start = Instant::now();
-    let full_width = u64::from(scene.film.resolution.0);
     let space = rendering_space(scene);
+    let mut watch = Watch::new(stop, space.pixels().max(1));
     let mut counts = RenderCounts::default();
     if sampler.streams() == 2 {
         film.split_streams(sampler.stream_weight());
@@ -320,40 +319,14 @@ pub fn render_with(
     if let Some(p) = progress {
         p.set_length(space.pixels() * u64::from(sampler.spp()));
     }
-    // A paired sampler's streams draw the integrator's decisions from sequences of their own:
-    // sharing one, a sample and its neighbour in the other stream would be a stratified pair,
-    // and one stream's values would tell where the other's went.
-    let streams = sampler.streams().max(1);
-    // pbrt-v3 scales the differentials to the spacing of a pixel's samples: 1 / sqrt(spp), of
-    // the scene's own budget (see `Scene::differential_scale`).
-    let diff_scale = scene.differential_scale;
-    let trace = |batch: &[SamplePoint], results: &mut Vec<SampleResult>| {
-        batch
-            .par_iter()
-            .map(|q| {
-                let key = u64::from(q.pixel[1]) * full_width + u64::from(q.pixel[0]);
-                let own = IndexStream {
-                    count: streams,
-                    which: q.index % streams,
-                };
-                // The integrator's decisions come after the dims the sampler drew.
-                let mut stream =
-                    SampleStream::new(key, q.index / streams, own.seed(seed), SOBOL_DIMS_USED);
-                let sample = CameraSample {
-                    film: Vec2::from(q.film),
-                    lens: Vec2::from(q.lens),
-                    time: q.time,
-                };
-                let r = if scene.uses_differentials {
-                    let (ray, diff) = scene.camera.generate_ray_differential(&sample);
-                    let diff = diff.scaled(&ray, diff_scale);
-                    li(scene, ray, Some(&diff), &mut stream)
-                } else {
-                    li(scene, scene.camera.generate_ray(&sample), None, &mut stream)
-                };
-                (r.l, r.rays, r.first_hit)
-            })
-            .collect_into_vec(results);
+    let tracer = Tracer {
+        scene,
+        li,
+        seed,
+        // A paired sampler's streams draw the integrator's decisions from sequences of their
+        // own: sharing one, a sample and its neighbour in the other stream would be a
+        // stratified pair, and one stream's values would tell where the other's went.
+        streams: sampler.streams().max(1),
     };
     // Reused from batch to batch: a fresh half-megabyte vector per batch costs page faults.
     let (mut batch, mut next) = (Vec::new(), Vec::new());
@@ -362,22 +335,15 @@ pub fn render_with(
     let mut traced = Traced::default();
     let mut pending = false;
     let mut in_sampler = Duration::ZERO;
-    // The noise threshold is looked at once per sample per pixel given (it reads every pixel),
-    // from `min_spp` on.
-    let pixels = space.pixels().max(1);
-    let mut next_check = pixels * u64::from(stop.min_spp.max(2));
-    let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     let last_pixel = space.pixel(space.pixels().saturating_sub(1));
     let in_passes = sampler.whole_passes();
-    // Set once the sampler planned for fewer samples than its budget to end in the time.
-    let mut planned_short = false;
     let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
     while more {
         // While `batch` is traced, the sampler and the film take the batch before and, when
         // the sampler plans ahead, it plans the next.
         let ahead = sampler.plans_ahead();
         let ((), planned) = rayon::join(
-            || trace(&batch, &mut results),
+            || tracer.trace(&batch, &mut results),
             || {
                 if pending {
                     traced.hand_over(sampler, film, &mut in_sampler);
@@ -394,44 +360,9 @@ pub fn render_with(
         // The film holds what the sampler has handed over so far, `batch` the last of it: a
         // batch ending at the last pixel ends a pass.
         let pass_done = !in_passes || batch.last().is_some_and(|q| q.pixel == last_pixel);
-        for (c, last) in stop.checkpoints.iter().zip(&mut last_look) {
-            if last.elapsed() >= c.every && (!c.whole_passes || pass_done) {
-                (c.look)(film, start.elapsed().as_secs_f64());
-                *last = Instant::now();
-            }
-        }
-        if counts.halted_by.is_none() {
-            if stop
-                .interrupt
-                .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
-            {
-                counts.halted_by = Some(Halt::Signal);
-                sampler.halt();
-            } else if stop.time_limit.is_some_and(|t| start.elapsed() >= t) {
-                counts.halted_by = Some(Halt::Time);
-                sampler.halt();
-            } else if let Some(threshold) = stop.noise_threshold {
-                if counts.samples >= next_check {
-                    next_check = counts.samples + pixels;
-                    if relative_error(film.pixel_stats()) < threshold {
-                        counts.halted_by = Some(Halt::Noise);
-                        sampler.halt();
-                    }
-                }
-            }
-        }
-        if let (Some(limit), true, None) = (stop.time_limit, stop.plan_to_time, counts.halted_by) {
-            // From one sample per pixel on, the speed so far is a fair guess of the rest.
-            if counts.samples >= pixels {
-                let spp = spp_in_time(counts.samples, pixels, start.elapsed(), limit);
-                // Once planned short, a later estimate may raise the plan again (to the cap).
-                if (spp < sampler.spp() || planned_short)
-                    && sampler.plan_for(spp.min(sampler.spp()))
-                {
-                    planned_short = true;
-                }
-            }
-        }
+        watch.look(film, pass_done);
+        watch.check(film, sampler, &mut counts);
+        watch.plan_to_time(sampler, &counts);
         match planned {
             Some(planned) => {
                 std::mem::swap(&mut batch, &mut next);
@@ -448,17 +379,166 @@ pub fn render_with(
         traced.hand_over(sampler, film, &mut in_sampler);
     }
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
-    if !counts.halted {
-        counts.halted_by = None;
-    } else if counts.halted_by.is_none() && planned_short {
-        // It ended as planned, the time spent.
-        counts.halted_by = Some(Halt::Time);
-    } else if counts.halted_by.is_none() && stop.noise_threshold.is_some() {
-        // A sampler that stops where it is settled ended by itself, everywhere settled.
-        counts.halted_by = Some(Halt::Noise);
-    }
+    watch.say_why_halted(&mut counts);
     counts.sampler_seconds = in_sampler.as_secs_f64();
     counts
+}
+
+/// Traces batches of sample points: camera rays and the estimator's radiance.
+struct Tracer<'s, 'e> {
+    /// The scene and its camera.
+    scene: &'s Scene,
+    /// What each sample estimates.
+    li: &'s Estimator<'e>,
+    /// The render's seed.
+    seed: u64,
+    /// The sampler's streams (at least 1), each drawing the integrator's decisions from
+    /// sequences of its own.
+    streams: u32,
+}
+
+impl Tracer<'_, '_> {
+    /// Traces `batch` in parallel into `results`, one per point, in its order.
+    fn trace(&self, batch: &[SamplePoint], results: &mut Vec<SampleResult>) {
+        let scene = self.scene;
+        let full_width = u64::from(scene.film.resolution.0);
+        // pbrt-v3 scales the differentials to the spacing of a pixel's samples: 1 / sqrt(spp),
+        // of the scene's own budget (see `Scene::differential_scale`).
+        let diff_scale = scene.differential_scale;
+        batch
+            .par_iter()
+            .map(|q| {
+                let key = u64::from(q.pixel[1]) * full_width + u64::from(q.pixel[0]);
+                let own = IndexStream {
+                    count: self.streams,
+                    which: q.index % self.streams,
+                };
+                // The integrator's decisions come after the dims the sampler drew.
+                let mut stream = SampleStream::new(
+                    key,
+                    q.index / self.streams,
+                    own.seed(self.seed),
+                    SOBOL_DIMS_USED,
+                );
+                let sample = CameraSample {
+                    film: Vec2::from(q.film),
+                    lens: Vec2::from(q.lens),
+                    time: q.time,
+                };
+                let li = self.li;
+                let r = if scene.uses_differentials {
+                    let (ray, diff) = scene.camera.generate_ray_differential(&sample);
+                    let diff = diff.scaled(&ray, diff_scale);
+                    li(scene, ray, Some(&diff), &mut stream)
+                } else {
+                    li(scene, scene.camera.generate_ray(&sample), None, &mut stream)
+                };
+                (r.l, r.rays, r.first_hit)
+            })
+            .collect_into_vec(results);
+    }
+}
+
+/// A render's [`Stop`] rules and what they keep between batches.
+struct Watch<'s, 'a> {
+    /// The rules.
+    stop: &'s Stop<'a>,
+    /// When the render started.
+    start: Instant,
+    /// The pixels rendered (at least 1).
+    pixels: u64,
+    /// The samples traced at which the noise threshold is next looked at: once per sample per
+    /// pixel given (it reads every pixel), from `min_spp` on.
+    next_check: u64,
+    /// When each checkpoint last looked.
+    last_look: Vec<Instant>,
+    /// Set once the sampler planned for fewer samples than its budget to end in the time.
+    planned_short: bool,
+}
+
+impl<'s, 'a> Watch<'s, 'a> {
+    /// The rules of `stop` for a render of `pixels` pixels starting now.
+    fn new(stop: &'s Stop<'a>, pixels: u64) -> Self {
+        Self {
+            stop,
+            start: Instant::now(),
+            pixels,
+            next_check: pixels * u64::from(stop.min_spp.max(2)),
+            last_look: vec![Instant::now(); stop.checkpoints.len()],
+            planned_short: false,
+        }
+    }
+
+    /// Lets the checkpoints that are due look at the film; one that waits for whole passes
+    /// looks only when `pass_done`.
+    fn look(&mut self, film: &Film, pass_done: bool) {
+        for (c, last) in self.stop.checkpoints.iter().zip(&mut self.last_look) {
+            if last.elapsed() >= c.every && (!c.whole_passes || pass_done) {
+                (c.look)(film, self.start.elapsed().as_secs_f64());
+                *last = Instant::now();
+            }
+        }
+    }
+
+    /// Halts the sampler, once, when a signal came, the time limit passed or the image is
+    /// below the noise threshold, and records why in `counts`.
+    fn check(&mut self, film: &Film, sampler: &mut dyn Sampler, counts: &mut RenderCounts) {
+        if counts.halted_by.is_some() {
+            return;
+        }
+        let stop = self.stop;
+        if stop
+            .interrupt
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            counts.halted_by = Some(Halt::Signal);
+            sampler.halt();
+        } else if stop.time_limit.is_some_and(|t| self.start.elapsed() >= t) {
+            counts.halted_by = Some(Halt::Time);
+            sampler.halt();
+        } else if let Some(threshold) = stop.noise_threshold {
+            if counts.samples >= self.next_check {
+                self.next_check = counts.samples + self.pixels;
+                if relative_error(film.pixel_stats()) < threshold {
+                    counts.halted_by = Some(Halt::Noise);
+                    sampler.halt();
+                }
+            }
+        }
+    }
+
+    /// With a time limit and [`Stop::plan_to_time`], tells the sampler how many samples per
+    /// pixel fit in the time left at the speed so far.
+    fn plan_to_time(&mut self, sampler: &mut dyn Sampler, counts: &RenderCounts) {
+        let stop = self.stop;
+        let (Some(limit), true, None) = (stop.time_limit, stop.plan_to_time, counts.halted_by)
+        else {
+            return;
+        };
+        // From one sample per pixel on, the speed so far is a fair guess of the rest.
+        if counts.samples >= self.pixels {
+            let spp = spp_in_time(counts.samples, self.pixels, self.start.elapsed(), limit);
+            // Once planned short, a later estimate may raise the plan again (to the cap).
+            if (spp < sampler.spp() || self.planned_short)
+                && sampler.plan_for(spp.min(sampler.spp()))
+            {
+                self.planned_short = true;
+            }
+        }
+    }
+
+    /// Once the render ended, why it halted (`counts.halted` set): none when it did not.
+    fn say_why_halted(&self, counts: &mut RenderCounts) {
+        if !counts.halted {
+            counts.halted_by = None;
+        } else if counts.halted_by.is_none() && self.planned_short {
+            // It ended as planned, the time spent.
+            counts.halted_by = Some(Halt::Time);
+        } else if counts.halted_by.is_none() && self.stop.noise_threshold.is_some() {
+            // A sampler that stops where it is settled ended by itself, everywhere settled.
+            counts.halted_by = Some(Halt::Noise);
+        }
+    }
 }
 
 /// The samples per pixel that fit in `limit` when `samples` over `pixels` took `elapsed`:

@@ -1,24 +1,23 @@
 //! The renderable scene, built once from a [`SceneDescription`]: camera, film settings,
 //! acceleration structure, lights, materials, and which dimensions the rendering space needs.
 
-use crate::accel::{Accel, Geometry, Instance, Placement, PrimKind};
+use crate::accel::{Accel, PrimKind};
 use crate::camera::Camera;
 use crate::film::FilmSettings;
-use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3};
-use crate::light::{prim_area, AreaShape, Light};
+use crate::geometry::{Ray, SurfaceInteraction, Vec3};
+use crate::light::Light;
 use crate::lightbvh::{LightBvh, LightContext};
 use crate::lightdistrib::{LightDistribution, LightPmf, LightStrategy};
 use crate::material::Material;
-use crate::transform::MotionTransform;
 use acr_parser::{Error, PluginDesc, Result, SceneDescription, Warning};
 use glam::DMat4;
 use std::collections::HashSet;
 use std::sync::{Arc, OnceLock};
 
+mod instances;
 mod lights;
 mod shapes;
 
-use lights::light_sample_count;
 pub use lights::rgb_param;
 
 /// What a primitive's surface is: its material and the area light it carries.
@@ -214,6 +213,8 @@ struct Builder<'a> {
     desc: &'a SceneDescription,
     warnings: &'a mut Vec<Warning>,
     warned: HashSet<String>,
+    /// Render space from world space (see [`Scene::render_from_world`]).
+    render_from_world: DMat4,
     surfaces: Vec<Surface>,
     lights: Vec<Light>,
     light_samples: Vec<u32>,
@@ -221,13 +222,35 @@ struct Builder<'a> {
     area_lights: Vec<(Arc<PluginDesc>, PrimKind, u32)>,
 }
 
+impl<'a> Builder<'a> {
+    /// A builder of `desc`'s scene placed by `render_from_world`, with nothing built yet.
+    fn new(
+        desc: &'a SceneDescription,
+        warnings: &'a mut Vec<Warning>,
+        render_from_world: DMat4,
+    ) -> Self {
+        Builder {
+            desc,
+            warnings,
+            warned: HashSet::new(),
+            render_from_world,
+            surfaces: Vec::new(),
+            lights: Vec::new(),
+            light_samples: Vec::new(),
+            area_lights: Vec::new(),
+        }
+    }
+}
+
 impl Builder<'_> {
+    /// Warns at `loc`, once per `key`.
     fn warn_once(&mut self, key: String, loc: &acr_parser::Loc, msg: String) {
         if self.warned.insert(key) {
             self.warnings.push(Warning::at(loc, msg));
         }
     }
 
+    /// Adds surface `s`; its index.
     fn surface(&mut self, s: Surface) -> u32 {
         self.surfaces.push(s);
         (self.surfaces.len() - 1) as u32
@@ -259,6 +282,46 @@ fn render_from_world(camera: &acr_parser::CameraDesc) -> Result<DMat4> {
     Ok(DMat4::from_translation(-camera_pos))
 }
 
+/// The scene's camera description; a scene without one is an error.
+fn camera_of(desc: &SceneDescription) -> Result<&acr_parser::CameraDesc> {
+    let Some(camera_desc) = &desc.camera else {
+        let path = desc
+            .files
+            .first()
+            .map(|f| f.path.clone())
+            .unwrap_or_default();
+        return Err(Error::file(path, "the scene has no Camera"));
+    };
+    Ok(camera_desc)
+}
+
+/// The centre and radius of the sphere around the box from `lo` to `hi`; the unit sphere
+/// when the box is empty.
+fn bounding_sphere(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
+    if lo.cmple(hi).all() {
+        ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+    } else {
+        (Vec3::ZERO, 1.0)
+    }
+}
+
+impl LightChoices {
+    /// The distributions over `lights`, in a world whose geometry spans `bounds`.
+    fn new(lights: &[Light], bounds: (Vec3, Vec3)) -> Self {
+        let powers: Vec<f32> = lights
+            .iter()
+            .map(|l| crate::spectrum_luminance(l.power()))
+            .collect();
+        LightChoices {
+            uniform: LightPmf::new(&vec![1.0; powers.len()]),
+            power: LightPmf::new(&powers),
+            spatial: OnceLock::new(),
+            bvh: OnceLock::new(),
+            bounds,
+        }
+    }
+}
+
 impl Scene {
     /// Builds the scene from its description. Warnings (unsupported features, unused
     /// parameters) are appended to `warnings`.
@@ -268,159 +331,19 @@ impl Scene {
             .first()
             .map(|f| f.dir().to_path_buf())
             .unwrap_or_default();
-        let Some(camera_desc) = &desc.camera else {
-            let path = desc
-                .files
-                .first()
-                .map(|f| f.path.clone())
-                .unwrap_or_default();
-            return Err(Error::file(path, "the scene has no Camera"));
-        };
+        let camera_desc = camera_of(desc)?;
         let film = FilmSettings::new(desc.film.as_ref())?;
         let render_from_world = render_from_world(camera_desc)?;
-        let in_render = |t: &acr_parser::AnimatedTransform| acr_parser::AnimatedTransform {
-            start: render_from_world * t.start,
-            end: render_from_world * t.end,
-            ..*t
-        };
         let camera = Camera::new(camera_desc, film.resolution, render_from_world)?;
-        let mut b = Builder {
-            desc,
-            warnings,
-            warned: HashSet::new(),
-            surfaces: Vec::new(),
-            lights: Vec::new(),
-            light_samples: Vec::new(),
-            area_lights: Vec::new(),
-        };
-        let mut accel = Accel::default();
-        let mut world = Geometry::default();
-        for shape in &desc.shapes {
-            let moving = shape.world_from_object.is_animated()
-                && shape.world_from_object.end_time > shape.world_from_object.start_time;
-            if moving {
-                if let Some(al) = &shape.area_light {
-                    b.warn_once(
-                        "moving area light".into(),
-                        &al.loc,
-                        "area lights on moving shapes are not supported (as in pbrt-v3); \
-                         the shape does not emit"
-                            .into(),
-                    );
-                }
-                let mut g = Geometry::default();
-                b.add_shape(&mut g, shape, &DMat4::IDENTITY, false)?;
-                accel.objects.push(g);
-                accel.instances.push(Instance {
-                    object: (accel.objects.len() - 1) as u32,
-                    placement: Placement::Moving(Box::new(MotionTransform::new(&in_render(
-                        &shape.world_from_object,
-                    )))),
-                });
-            } else {
-                let m = render_from_world * shape.world_from_object.start;
-                b.add_shape(&mut world, shape, &m, true)?;
-            }
-        }
-        let first_object = accel.objects.len() as u32;
-        for object in b.desc.objects.values() {
-            let mut g = Geometry::default();
-            for shape in &object.shapes {
-                if shape.world_from_object.is_animated() {
-                    b.warn_once(
-                        "animated in object".into(),
-                        &shape.plugin.loc,
-                        "motion inside an object definition is not supported; the shape is \
-                         placed at its start transform (move the instance instead)"
-                            .into(),
-                    );
-                }
-                b.add_shape(&mut g, shape, &shape.world_from_object.start, false)?;
-            }
-            accel.objects.push(g);
-        }
-        for inst in &desc.instances {
-            let t = &in_render(&inst.world_from_instance);
-            let placement = if t.is_animated() && t.end_time > t.start_time {
-                Placement::Moving(Box::new(MotionTransform::new(t)))
-            } else {
-                Placement::Fixed {
-                    to_world: t.start.as_mat4(),
-                    to_local: t.start.inverse().as_mat4(),
-                }
-            };
-            accel.instances.push(Instance {
-                object: first_object + inst.object as u32,
-                placement,
-            });
-        }
-        accel.world = world;
-        let dropped = accel.build();
-        if dropped > 0 {
-            b.warnings.push(Warning {
-                loc: None,
-                message: format!(
-                    "{dropped} object instances are placed beyond the range of 32-bit floats \
-                     and are skipped"
-                ),
-            });
-        }
+        let mut b = Builder::new(desc, warnings, render_from_world);
+        let accel = b.accel()?;
         let (lo, hi) = accel.bounds();
-        let (world_center, world_radius) = if lo.cmple(hi).all() {
-            ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
-        } else {
-            (Vec3::ZERO, 1.0)
-        };
+        let (world_center, world_radius) = bounding_sphere(lo, hi);
         // Area lights, now that the world geometry has its final layout.
-        for (light, kind, surface) in std::mem::take(&mut b.area_lights) {
-            if !matches!(light.kind.as_str(), "area" | "diffuse") {
-                return Err(Error::at(
-                    &light.loc,
-                    format!(
-                        "area light \"{}\" is not supported (only \"diffuse\")",
-                        light.kind
-                    ),
-                ));
-            }
-            let params = &light.params;
-            let l_emit =
-                rgb_param(params, "L", Spectrum::ONE)? * rgb_param(params, "scale", Spectrum::ONE)?;
-            let two_sided = params.bool_or("twosided", false)?;
-            let samples = light_sample_count(params)?;
-            let area = prim_area(&accel.world, kind);
-            if area > 0.0 && l_emit.max_element() > 0.0 {
-                b.lights.push(Light::Area {
-                    shape: AreaShape { kind },
-                    l_emit,
-                    two_sided,
-                    area,
-                });
-                b.light_samples.push(samples);
-                b.surfaces[surface as usize].area_light = Some((b.lights.len() - 1) as u32);
-            }
-        }
-        for l in &desc.lights {
-            if let Some(light) = b.light(
-                &l.plugin,
-                &(render_from_world * l.world_from_light),
-                world_radius,
-                &main_dir,
-            )? {
-                let samples = match light {
-                    Light::Infinite { .. } => light_sample_count(&l.plugin.params)?,
-                    _ => 1,
-                };
-                b.lights.push(light);
-                b.light_samples.push(samples);
-            }
-        }
+        b.add_area_lights(&accel)?;
+        b.add_lights(world_radius, &main_dir)?;
         let materials =
             crate::material::build_materials(desc, &main_dir, render_from_world, b.warnings)?;
-        let powers: Vec<f32> = b
-            .lights
-            .iter()
-            .map(|l| crate::spectrum_luminance(l.power()))
-            .collect();
         let infinite_lights = b
             .lights
             .iter()
@@ -437,13 +360,7 @@ impl Scene {
             camera,
             film,
             accel,
-            light_choice: LightChoices {
-                uniform: LightPmf::new(&vec![1.0; powers.len()]),
-                power: LightPmf::new(&powers),
-                spatial: OnceLock::new(),
-                bvh: OnceLock::new(),
-                bounds: (lo, hi),
-            },
+            light_choice: LightChoices::new(&b.lights, (lo, hi)),
             lights: b.lights,
             light_samples: b.light_samples,
             infinite_lights,

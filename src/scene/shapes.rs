@@ -115,150 +115,249 @@ impl Builder<'_> {
             return Ok(());
         }
         let mut area_light = shape.area_light.as_ref().filter(|_| emit);
+        let Some(made) = self.primitives(geom, shape, transform_of(m))? else {
+            return Ok(());
+        };
+        if !made.can_emit {
+            area_light = self.no_emission(area_light, p);
+        }
+        let prims = self.within_range(geom, made.prims, p);
         let material = shape.material.map(|m| m as u32);
-        let to_world = transform_of(m);
-        let params = &p.params;
-        let mut prims: Vec<PrimKind> = Vec::new();
-        match kind {
-            "trianglemesh" | "plymesh" => {
-                let Some(mesh) = &shape.mesh else {
-                    return Ok(());
-                };
-                let tm = TriangleMesh::from_mesh(mesh, &to_world, shape.reverse_orientation);
-                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
-                // Parameters pbrt-v3 reads for meshes that acr has no use for.
-                for unused in ["alpha", "shadowalpha", "S", "faceIndices"] {
-                    if let Some(x) = params.get(unused) {
-                        self.warn_once(
-                            format!("mesh param {unused}"),
-                            &x.loc,
-                            format!("mesh parameter \"{unused}\" is not supported; ignored"),
-                        );
-                    }
-                }
+        self.add_surfaces(geom, prims, material, area_light);
+        Ok(())
+    }
+
+    /// The primitives of one shape, added to `geom`'s shapes of its kind but not yet to its
+    /// primitives; `None` when the shape is skipped (with a warning where it says why).
+    fn primitives(
+        &mut self,
+        geom: &mut Geometry,
+        shape: &ShapeDesc,
+        to_world: Transform,
+    ) -> Result<Option<Made>> {
+        let p = &shape.plugin;
+        let kind = p.kind.as_str();
+        let flip = shape.reverse_orientation;
+        let prims = match kind {
+            "trianglemesh" | "plymesh" | "loopsubdiv" | "heightfield" | "nurbs" => {
+                self.mesh(geom, shape, &to_world)?
             }
-            "loopsubdiv" => {
-                let mesh =
-                    crate::shapes::loopsubdiv::mesh_from_params(params, &p.loc, self.warnings)?;
-                let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
-                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
-            }
-            "heightfield" => {
-                let mesh = crate::shapes::heightfield::mesh_from_params(params, &p.loc)?;
-                let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
-                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
-            }
-            "nurbs" => {
-                let mesh = crate::shapes::nurbs::mesh_from_params(params, &p.loc)?;
-                let tm = TriangleMesh::from_mesh(&mesh, &to_world, shape.reverse_orientation);
-                self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
-            }
-            "sphere" => {
-                let r = params.float_or("radius", 1.0)? as f32;
-                if !self.positive_size(p, "radius", r) {
-                    return Ok(());
-                }
-                let s = Sphere::new(
-                    r,
-                    params.float_or("zmin", -r as f64)? as f32,
-                    params.float_or("zmax", r as f64)? as f32,
-                    params.float_or("phimax", 360.0)? as f32,
-                    to_world,
-                    shape.reverse_orientation,
-                );
-                prims.push(PrimKind::Sphere(geom.spheres.len() as u32));
-                geom.spheres.push(s);
-            }
-            "disk" => {
-                let (r, ri) = (
-                    params.float_or("radius", 1.0)? as f32,
-                    params.float_or("innerradius", 0.0)? as f32,
-                );
-                if !self.positive_size(p, "radius", r)
-                    || !self.positive_size(p, "radius - innerradius", r - ri.max(0.0))
-                {
-                    return Ok(());
-                }
-                let d = Disk::new(
-                    params.float_or("height", 0.0)? as f32,
-                    r,
-                    ri.max(0.0),
-                    params.float_or("phimax", 360.0)? as f32,
-                    to_world,
-                    shape.reverse_orientation,
-                );
-                prims.push(PrimKind::Disk(geom.disks.len() as u32));
-                geom.disks.push(d);
-            }
-            "cylinder" => {
-                let r = params.float_or("radius", 1.0)? as f32;
-                let (z0, z1) = (
-                    params.float_or("zmin", -1.0)? as f32,
-                    params.float_or("zmax", 1.0)? as f32,
-                );
-                if !self.positive_size(p, "radius", r)
-                    || !self.positive_size(p, "|zmax - zmin|", (z1 - z0).abs())
-                {
-                    return Ok(());
-                }
-                let c = Cylinder::new(
-                    r,
-                    z0,
-                    z1,
-                    params.float_or("phimax", 360.0)? as f32,
-                    to_world,
-                    shape.reverse_orientation,
-                );
-                prims.push(PrimKind::Cylinder(geom.cylinders.len() as u32));
-                geom.cylinders.push(c);
-            }
+            "sphere" => self.sphere(geom, p, to_world, flip)?,
+            "disk" => self.disk(geom, p, to_world, flip)?,
+            "cylinder" => self.cylinder(geom, p, to_world, flip)?,
             "cone" | "paraboloid" | "hyperboloid" => {
-                let built = crate::shapes::revolved::from_params(
-                    kind,
-                    params,
-                    to_world,
-                    shape.reverse_orientation,
-                )?;
-                let shape = match built {
-                    Ok(s) => s,
-                    Err(why) => {
-                        self.warnings.push(Warning::at(&p.loc, why));
-                        return Ok(());
-                    }
-                };
-                area_light = self.no_emission(area_light, p);
-                prims.push(PrimKind::Revolved(geom.revolved.len() as u32));
-                geom.revolved.push(shape);
+                return self.revolved(geom, p, to_world, flip);
             }
-            "curve" => {
-                let curves = crate::shapes::curve::from_params(
-                    params,
-                    &p.loc,
-                    to_world,
-                    shape.reverse_orientation,
-                    self.warnings,
-                )?;
-                area_light = self.no_emission(area_light, p);
-                for (common, pieces) in curves {
-                    let index = geom.curve_commons.len() as u32;
-                    geom.curve_commons.push(common);
-                    for mut piece in pieces {
-                        piece.common = index;
-                        prims.push(PrimKind::Curve(geom.curves.len() as u32));
-                        geom.curves.push(piece);
-                    }
-                }
-            }
+            "curve" => return self.curves(geom, p, to_world, flip).map(Some),
             other => {
                 self.warn_once(
                     format!("shape {other}"),
                     &p.loc,
                     format!("unknown shape \"{other}\"; shapes of this type are skipped"),
                 );
-                return Ok(());
+                None
+            }
+        };
+        Ok(prims.map(|prims| Made {
+            prims,
+            can_emit: true,
+        }))
+    }
+
+    /// A triangle mesh (`trianglemesh`, `plymesh`) or a shape acr turns into one
+    /// (`loopsubdiv`, `heightfield`, `nurbs`); `None` for a mesh shape without its mesh.
+    fn mesh(
+        &mut self,
+        geom: &mut Geometry,
+        shape: &ShapeDesc,
+        to_world: &Transform,
+    ) -> Result<Option<Vec<PrimKind>>> {
+        let p = &shape.plugin;
+        let params = &p.params;
+        let kind = p.kind.as_str();
+        let built;
+        let mesh = match kind {
+            "loopsubdiv" => {
+                built = crate::shapes::loopsubdiv::mesh_from_params(params, &p.loc, self.warnings)?;
+                &built
+            }
+            "heightfield" => {
+                built = crate::shapes::heightfield::mesh_from_params(params, &p.loc)?;
+                &built
+            }
+            "nurbs" => {
+                built = crate::shapes::nurbs::mesh_from_params(params, &p.loc)?;
+                &built
+            }
+            _ => match &shape.mesh {
+                Some(mesh) => mesh,
+                None => return Ok(None),
+            },
+        };
+        let tm = TriangleMesh::from_mesh(mesh, to_world, shape.reverse_orientation);
+        let mut prims = Vec::new();
+        self.add_triangles(geom, tm, &mut prims, &p.loc, kind);
+        if matches!(kind, "trianglemesh" | "plymesh") {
+            // Parameters pbrt-v3 reads for meshes that acr has no use for.
+            for unused in ["alpha", "shadowalpha", "S", "faceIndices"] {
+                if let Some(x) = params.get(unused) {
+                    self.warn_once(
+                        format!("mesh param {unused}"),
+                        &x.loc,
+                        format!("mesh parameter \"{unused}\" is not supported; ignored"),
+                    );
+                }
             }
         }
-        // Coordinates beyond f32's range (or NaN) relative to the camera: no box holds them.
+        Ok(Some(prims))
+    }
+
+    /// A sphere; `None` when its radius is not positive.
+    fn sphere(
+        &mut self,
+        geom: &mut Geometry,
+        p: &PluginDesc,
+        to_world: Transform,
+        flip: bool,
+    ) -> Result<Option<Vec<PrimKind>>> {
+        let params = &p.params;
+        let r = params.float_or("radius", 1.0)? as f32;
+        if !self.positive_size(p, "radius", r) {
+            return Ok(None);
+        }
+        let s = Sphere::new(
+            r,
+            params.float_or("zmin", -r as f64)? as f32,
+            params.float_or("zmax", r as f64)? as f32,
+            params.float_or("phimax", 360.0)? as f32,
+            to_world,
+            flip,
+        );
+        geom.spheres.push(s);
+        Ok(Some(vec![PrimKind::Sphere(geom.spheres.len() as u32 - 1)]))
+    }
+
+    /// A disk or annulus; `None` when its radius or width is not positive.
+    fn disk(
+        &mut self,
+        geom: &mut Geometry,
+        p: &PluginDesc,
+        to_world: Transform,
+        flip: bool,
+    ) -> Result<Option<Vec<PrimKind>>> {
+        let params = &p.params;
+        let (r, ri) = (
+            params.float_or("radius", 1.0)? as f32,
+            params.float_or("innerradius", 0.0)? as f32,
+        );
+        if !self.positive_size(p, "radius", r)
+            || !self.positive_size(p, "radius - innerradius", r - ri.max(0.0))
+        {
+            return Ok(None);
+        }
+        let d = Disk::new(
+            params.float_or("height", 0.0)? as f32,
+            r,
+            ri.max(0.0),
+            params.float_or("phimax", 360.0)? as f32,
+            to_world,
+            flip,
+        );
+        geom.disks.push(d);
+        Ok(Some(vec![PrimKind::Disk(geom.disks.len() as u32 - 1)]))
+    }
+
+    /// A cylinder; `None` when its radius or height is not positive.
+    fn cylinder(
+        &mut self,
+        geom: &mut Geometry,
+        p: &PluginDesc,
+        to_world: Transform,
+        flip: bool,
+    ) -> Result<Option<Vec<PrimKind>>> {
+        let params = &p.params;
+        let r = params.float_or("radius", 1.0)? as f32;
+        let (z0, z1) = (
+            params.float_or("zmin", -1.0)? as f32,
+            params.float_or("zmax", 1.0)? as f32,
+        );
+        if !self.positive_size(p, "radius", r)
+            || !self.positive_size(p, "|zmax - zmin|", (z1 - z0).abs())
+        {
+            return Ok(None);
+        }
+        let c = Cylinder::new(
+            r,
+            z0,
+            z1,
+            params.float_or("phimax", 360.0)? as f32,
+            to_world,
+            flip,
+        );
+        geom.cylinders.push(c);
+        Ok(Some(vec![PrimKind::Cylinder(
+            geom.cylinders.len() as u32 - 1,
+        )]))
+    }
+
+    /// A cone, paraboloid or hyperboloid, which cannot emit; `None`, with a warning saying
+    /// why, when its parameters make no surface.
+    fn revolved(
+        &mut self,
+        geom: &mut Geometry,
+        p: &PluginDesc,
+        to_world: Transform,
+        flip: bool,
+    ) -> Result<Option<Made>> {
+        let built = crate::shapes::revolved::from_params(&p.kind, &p.params, to_world, flip)?;
+        let shape = match built {
+            Ok(s) => s,
+            Err(why) => {
+                self.warnings.push(Warning::at(&p.loc, why));
+                return Ok(None);
+            }
+        };
+        geom.revolved.push(shape);
+        Ok(Some(Made {
+            prims: vec![PrimKind::Revolved(geom.revolved.len() as u32 - 1)],
+            can_emit: false,
+        }))
+    }
+
+    /// A curve's segments, each split into its pieces, which cannot emit.
+    fn curves(
+        &mut self,
+        geom: &mut Geometry,
+        p: &PluginDesc,
+        to_world: Transform,
+        flip: bool,
+    ) -> Result<Made> {
+        let curves =
+            crate::shapes::curve::from_params(&p.params, &p.loc, to_world, flip, self.warnings)?;
+        let mut prims = Vec::new();
+        for (common, pieces) in curves {
+            let index = geom.curve_commons.len() as u32;
+            geom.curve_commons.push(common);
+            for mut piece in pieces {
+                piece.common = index;
+                prims.push(PrimKind::Curve(geom.curves.len() as u32));
+                geom.curves.push(piece);
+            }
+        }
+        Ok(Made {
+            prims,
+            can_emit: false,
+        })
+    }
+
+    /// `prims` without those whose coordinates lie beyond f32's range (or are NaN) relative
+    /// to the camera: no box holds them. Warns of those dropped.
+    fn within_range(
+        &mut self,
+        geom: &Geometry,
+        mut prims: Vec<PrimKind>,
+        p: &PluginDesc,
+    ) -> Vec<PrimKind> {
         let before = prims.len();
         prims.retain(|&k| {
             let (lo, hi) = geom.kind_bounds(k);
@@ -268,13 +367,26 @@ impl Builder<'_> {
             self.warnings.push(Warning::at(
                 &p.loc,
                 format!(
-                    "{kind}: {} of {before} primitives lie beyond the range of 32-bit floats \
+                    "{}: {} of {before} primitives lie beyond the range of 32-bit floats \
                      seen from the camera, or have NaN coordinates, and are skipped",
+                    p.kind,
                     before - prims.len()
                 ),
             ));
         }
-        if area_light.is_none() {
+        prims
+    }
+
+    /// Adds `prims` to `geom` with their surface of `material`: one surface for them all, or
+    /// with an area light one each, its light waiting for the world's final layout.
+    fn add_surfaces(
+        &mut self,
+        geom: &mut Geometry,
+        prims: Vec<PrimKind>,
+        material: Option<u32>,
+        area_light: Option<&Arc<PluginDesc>>,
+    ) {
+        let Some(light) = area_light else {
             let surface = self.surface(Surface {
                 material,
                 area_light: None,
@@ -282,20 +394,24 @@ impl Builder<'_> {
             for kind in prims {
                 geom.push(Prim { kind, surface });
             }
-            return Ok(());
-        }
-        let light = area_light.cloned();
+            return;
+        };
         for kind in prims {
             // One light per primitive, as pbrt-v3 makes one DiffuseAreaLight per shape.
             let surface = self.surface(Surface {
                 material,
                 area_light: None,
             });
-            if let Some(l) = &light {
-                self.area_lights.push((Arc::clone(l), kind, surface));
-            }
+            self.area_lights.push((Arc::clone(light), kind, surface));
             geom.push(Prim { kind, surface });
         }
-        Ok(())
     }
+}
+
+/// The primitives a shape made, and whether they may carry its area light.
+struct Made {
+    /// The primitives.
+    prims: Vec<PrimKind>,
+    /// False for shapes pbrt-v3 cannot sample: their area light is dropped.
+    can_emit: bool,
 }

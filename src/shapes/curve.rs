@@ -413,154 +413,21 @@ pub fn from_params(
     reverse_orientation: bool,
     warnings: &mut Vec<Warning>,
 ) -> Result<Vec<(CurveCommon, Vec<Curve>)>> {
-    let at = |name: &str| {
-        params
-            .get(name)
-            .map_or_else(|| loc.clone(), |p| p.loc.clone())
-    };
     let width = params.float_or("width", 1.0)? as f32;
     let width0 = params.float_or("width0", width as f64)? as f32;
     let width1 = params.float_or("width1", width as f64)? as f32;
-    let degree = params.int_or("degree", 3)?;
-    if degree != 2 && degree != 3 {
-        return Err(Error::at(
-            &at("degree"),
-            format!("curve: degree {degree}; only degree 2 and 3 curves are supported"),
-        ));
-    }
-    let degree = degree as usize;
-    let basis = params.string("basis")?.unwrap_or("bezier");
-    if basis != "bezier" && basis != "bspline" {
-        return Err(Error::at(
-            &at("basis"),
-            format!("curve: basis \"{basis}\"; only \"bezier\" and \"bspline\" are supported"),
-        ));
-    }
-    let Some(flat) = params.numbers("P", ParamType::Point3)? else {
-        return Err(Error::at(
-            loc,
-            "curve needs its control points \"point3 P\"",
-        ));
-    };
-    let cp: Vec<Vec3> = flat
-        .chunks_exact(3)
-        .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
-        .collect();
-    let ncp = cp.len();
-    let segments = if basis == "bezier" {
-        if ncp < degree + 1 || (ncp - 1 - degree) % degree != 0 {
-            return Err(Error::at(
-                &at("P"),
-                format!(
-                    "curve: {ncp} control points; the degree {degree} Bezier basis needs {} + n * \
-                     {degree}, for n >= 0",
-                    degree + 1
-                ),
-            ));
-        }
-        (ncp - 1) / degree
-    } else {
-        if ncp < degree + 1 {
-            return Err(Error::at(
-                &at("P"),
-                format!(
-                    "curve: {ncp} control points; the degree {degree} b-spline basis needs at \
-                     least {}",
-                    degree + 1
-                ),
-            ));
-        }
-        ncp - degree
-    };
-    let kind = match params.string("type")?.unwrap_or("flat") {
-        "flat" => CurveType::Flat,
-        "ribbon" => CurveType::Ribbon,
-        "cylinder" => CurveType::Cylinder,
-        other => {
-            warnings.push(Warning::at(
-                &at("type"),
-                format!("curve: unknown type \"{other}\"; using \"cylinder\", as pbrt-v3 does"),
-            ));
-            CurveType::Cylinder
-        }
-    };
-    let normals = match params.numbers("N", ParamType::Normal)? {
-        Some(_) if kind != CurveType::Ribbon => {
-            warnings.push(Warning::at(
-                &at("N"),
-                "curve: normals are only used with \"ribbon\" curves; ignored",
-            ));
-            None
-        }
-        Some(n) => {
-            let n: Vec<Vec3> = n
-                .chunks_exact(3)
-                .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
-                .collect();
-            if n.len() != segments + 1 {
-                return Err(Error::at(
-                    &at("N"),
-                    format!(
-                        "curve: {} normals; ribbon curves with {segments} segments need {}",
-                        n.len(),
-                        segments + 1
-                    ),
-                ));
-            }
-            Some(n)
-        }
-        None if kind == CurveType::Ribbon => {
-            return Err(Error::at(
-                loc,
-                "ribbon curves need normals \"N\" at the segment ends",
-            ));
-        }
-        None => None,
-    };
-    let split_depth = match params.int("splitdepth") {
-        Ok(Some(s)) => s,
-        Ok(None) => 3,
-        // pbrt-v3 reads it as an integer, or failing that as a float.
-        Err(_) => params.float_or("splitdepth", 3.0)? as i32,
-    };
-    let pieces = 1usize << split_depth.clamp(0, 10);
-    let lerp = |t: f32, a: Vec3, b: Vec3| a.lerp(b, t);
+    let degree = curve_degree(params, loc)?;
+    let basis = Basis::from_params(params, loc)?;
+    let cp = control_points(params, loc)?;
+    let segments = basis.segments(cp.len(), degree, params, loc)?;
+    let kind = curve_type(params, loc, warnings)?;
+    let normals = ribbon_normals(params, loc, kind, segments, warnings)?;
+    let pieces = 1usize << split_depth(params)?.clamp(0, 10);
     let mut out = Vec::with_capacity(segments);
     for seg in 0..segments {
-        let bezier = if basis == "bezier" {
-            let b = &cp[seg * degree..];
-            if degree == 2 {
-                [
-                    b[0],
-                    lerp(2.0 / 3.0, b[0], b[1]),
-                    lerp(1.0 / 3.0, b[1], b[2]),
-                    b[2],
-                ]
-            } else {
-                [b[0], b[1], b[2], b[3]]
-            }
-        } else {
-            let b = &cp[seg..];
-            if degree == 2 {
-                let p11 = lerp(0.5, b[0], b[1]);
-                let p22 = lerp(0.5, b[1], b[2]);
-                [
-                    p11,
-                    lerp(2.0 / 3.0, p11, b[1]),
-                    lerp(1.0 / 3.0, b[1], p22),
-                    p22,
-                ]
-            } else {
-                let p122 = lerp(2.0 / 3.0, b[0], b[1]);
-                let p223 = lerp(1.0 / 3.0, b[1], b[2]);
-                let p233 = lerp(2.0 / 3.0, b[1], b[2]);
-                let p334 = lerp(1.0 / 3.0, b[2], b[3]);
-                [lerp(0.5, p122, p223), p223, p233, lerp(0.5, p233, p334)]
-            }
-        };
         let w = |i: usize| width0 + (width1 - width0) * (i as f32 / segments as f32);
         let common = CurveCommon::new(
-            bezier,
+            basis.bezier(&cp, degree, seg),
             [w(seg), w(seg + 1)],
             kind,
             normals.as_ref().map(|n| [n[seg], n[seg + 1]]),
@@ -577,6 +444,205 @@ pub fn from_params(
         out.push((common, pieces));
     }
     Ok(out)
+}
+
+/// Where parameter `name` was written, else where the shape was.
+fn param_loc(params: &ParamList, loc: &Loc, name: &str) -> Loc {
+    params
+        .get(name)
+        .map_or_else(|| loc.clone(), |p| p.loc.clone())
+}
+
+/// The curve's `degree`: 2 or 3.
+fn curve_degree(params: &ParamList, loc: &Loc) -> Result<usize> {
+    let degree = params.int_or("degree", 3)?;
+    if degree != 2 && degree != 3 {
+        return Err(Error::at(
+            &param_loc(params, loc, "degree"),
+            format!("curve: degree {degree}; only degree 2 and 3 curves are supported"),
+        ));
+    }
+    Ok(degree as usize)
+}
+
+/// The control points `P`, which a curve must have.
+fn control_points(params: &ParamList, loc: &Loc) -> Result<Vec<Vec3>> {
+    let Some(flat) = params.numbers("P", ParamType::Point3)? else {
+        return Err(Error::at(
+            loc,
+            "curve needs its control points \"point3 P\"",
+        ));
+    };
+    Ok(vec3s(flat))
+}
+
+/// Three numbers at a time as vectors.
+fn vec3s(flat: &[f64]) -> Vec<Vec3> {
+    flat.chunks_exact(3)
+        .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
+        .collect()
+}
+
+/// The basis the control points are in (`basis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Basis {
+    /// Bézier segments sharing their end points.
+    Bezier,
+    /// A uniform b-spline.
+    BSpline,
+}
+
+impl Basis {
+    /// The `basis` parameter: `bezier` (the default) or `bspline`.
+    fn from_params(params: &ParamList, loc: &Loc) -> Result<Basis> {
+        match params.string("basis")?.unwrap_or("bezier") {
+            "bezier" => Ok(Basis::Bezier),
+            "bspline" => Ok(Basis::BSpline),
+            basis => Err(Error::at(
+                &param_loc(params, loc, "basis"),
+                format!("curve: basis \"{basis}\"; only \"bezier\" and \"bspline\" are supported"),
+            )),
+        }
+    }
+
+    /// How many segments `ncp` control points of `degree` make; an error at `P` when the
+    /// count does not fit the basis.
+    fn segments(self, ncp: usize, degree: usize, params: &ParamList, loc: &Loc) -> Result<usize> {
+        let at = || param_loc(params, loc, "P");
+        match self {
+            Basis::Bezier => {
+                if ncp < degree + 1 || (ncp - 1 - degree) % degree != 0 {
+                    return Err(Error::at(
+                        &at(),
+                        format!(
+                            "curve: {ncp} control points; the degree {degree} Bezier basis needs \
+                             {} + n * {degree}, for n >= 0",
+                            degree + 1
+                        ),
+                    ));
+                }
+                Ok((ncp - 1) / degree)
+            }
+            Basis::BSpline => {
+                if ncp < degree + 1 {
+                    return Err(Error::at(
+                        &at(),
+                        format!(
+                            "curve: {ncp} control points; the degree {degree} b-spline basis \
+                             needs at least {}",
+                            degree + 1
+                        ),
+                    ));
+                }
+                Ok(ncp - degree)
+            }
+        }
+    }
+
+    /// The cubic Bézier control points of segment `seg` of `cp` (degree 2 elevated to 3,
+    /// b-splines converted), as pbrt-v3 computes them.
+    fn bezier(self, cp: &[Vec3], degree: usize, seg: usize) -> [Vec3; 4] {
+        let lerp = |t: f32, a: Vec3, b: Vec3| a.lerp(b, t);
+        match (self, degree) {
+            (Basis::Bezier, 2) => {
+                let b = &cp[seg * degree..];
+                [
+                    b[0],
+                    lerp(2.0 / 3.0, b[0], b[1]),
+                    lerp(1.0 / 3.0, b[1], b[2]),
+                    b[2],
+                ]
+            }
+            (Basis::Bezier, _) => {
+                let b = &cp[seg * degree..];
+                [b[0], b[1], b[2], b[3]]
+            }
+            (Basis::BSpline, 2) => {
+                let b = &cp[seg..];
+                let p11 = lerp(0.5, b[0], b[1]);
+                let p22 = lerp(0.5, b[1], b[2]);
+                [
+                    p11,
+                    lerp(2.0 / 3.0, p11, b[1]),
+                    lerp(1.0 / 3.0, b[1], p22),
+                    p22,
+                ]
+            }
+            (Basis::BSpline, _) => {
+                let b = &cp[seg..];
+                let p122 = lerp(2.0 / 3.0, b[0], b[1]);
+                let p223 = lerp(1.0 / 3.0, b[1], b[2]);
+                let p233 = lerp(2.0 / 3.0, b[1], b[2]);
+                let p334 = lerp(1.0 / 3.0, b[2], b[3]);
+                [lerp(0.5, p122, p223), p223, p233, lerp(0.5, p233, p334)]
+            }
+        }
+    }
+}
+
+/// The curve's `type`; an unknown one warns and is a cylinder, as in pbrt-v3.
+fn curve_type(params: &ParamList, loc: &Loc, warnings: &mut Vec<Warning>) -> Result<CurveType> {
+    Ok(match params.string("type")?.unwrap_or("flat") {
+        "flat" => CurveType::Flat,
+        "ribbon" => CurveType::Ribbon,
+        "cylinder" => CurveType::Cylinder,
+        other => {
+            warnings.push(Warning::at(
+                &param_loc(params, loc, "type"),
+                format!("curve: unknown type \"{other}\"; using \"cylinder\", as pbrt-v3 does"),
+            ));
+            CurveType::Cylinder
+        }
+    })
+}
+
+/// A ribbon's normals `N`, one at each segment end, which it must have; other kinds ignore
+/// them with a warning.
+fn ribbon_normals(
+    params: &ParamList,
+    loc: &Loc,
+    kind: CurveType,
+    segments: usize,
+    warnings: &mut Vec<Warning>,
+) -> Result<Option<Vec<Vec3>>> {
+    let at = || param_loc(params, loc, "N");
+    match params.numbers("N", ParamType::Normal)? {
+        Some(_) if kind != CurveType::Ribbon => {
+            warnings.push(Warning::at(
+                &at(),
+                "curve: normals are only used with \"ribbon\" curves; ignored",
+            ));
+            Ok(None)
+        }
+        Some(n) => {
+            let n = vec3s(n);
+            if n.len() != segments + 1 {
+                return Err(Error::at(
+                    &at(),
+                    format!(
+                        "curve: {} normals; ribbon curves with {segments} segments need {}",
+                        n.len(),
+                        segments + 1
+                    ),
+                ));
+            }
+            Ok(Some(n))
+        }
+        None if kind == CurveType::Ribbon => Err(Error::at(
+            loc,
+            "ribbon curves need normals \"N\" at the segment ends",
+        )),
+        None => Ok(None),
+    }
+}
+
+/// `splitdepth` (default 3): pbrt-v3 reads it as an integer, or failing that as a float.
+fn split_depth(params: &ParamList) -> Result<i32> {
+    Ok(match params.int("splitdepth") {
+        Ok(Some(s)) => s,
+        Ok(None) => 3,
+        Err(_) => params.float_or("splitdepth", 3.0)? as i32,
+    })
 }
 
 #[cfg(test)]

@@ -5,7 +5,8 @@ use crate::image_io::{read_image, RgbImage};
 use crate::mipmap::MipMap;
 use crate::procedural::NoisePattern;
 use acr_parser::{
-    Error, Loc, ParamList, Result, SceneDescription, TextureRef, TextureValue, Values, Warning,
+    Error, Loc, ParamList, Result, SceneDescription, TextureDesc, TextureRef, TextureValue, Values,
+    Warning,
 };
 use glam::{DMat4, Mat4};
 use std::collections::{HashMap, HashSet};
@@ -329,6 +330,7 @@ impl<'a> TextureBuilder<'a> {
         }
     }
 
+    /// Texture `index` of the scene, of value type `T`: built on first use, then shared.
     fn texture<T: Build>(&mut self, index: usize) -> Result<Arc<Texture<T>>> {
         if let Some(t) = T::cache(self).get(index).cloned().flatten() {
             return Ok(t);
@@ -346,9 +348,18 @@ impl<'a> TextureBuilder<'a> {
                 format!("internal: texture \"{}\" has the wrong value type", td.name),
             ));
         }
+        let tex = Arc::new(self.new_texture::<T>(td)?);
+        if let Some(slot) = T::cache(self).get_mut(index) {
+            *slot = Some(Arc::clone(&tex));
+        }
+        Ok(tex)
+    }
+
+    /// A texture of `td`'s class and parameters.
+    fn new_texture<T: Build>(&mut self, td: &TextureDesc) -> Result<Texture<T>> {
         let p = &td.plugin.params;
         let loc = &td.plugin.loc;
-        let tex = match td.plugin.kind.as_str() {
+        Ok(match td.plugin.kind.as_str() {
             "constant" => Texture::Constant(
                 self.param_opt::<T>(p, "value")?
                     .and_then(|t| t.as_constant())
@@ -363,85 +374,14 @@ impl<'a> TextureBuilder<'a> {
                 tex1: self.param_or(p, "tex1", T::ZERO)?,
                 tex2: self.param_or(p, "tex2", T::ONE)?,
             },
-            "checkerboard" => {
-                let tex1 = self.param_or(p, "tex1", T::ONE)?;
-                let tex2 = self.param_or(p, "tex2", T::ZERO)?;
-                match p.int_or("dimension", 2)? {
-                    2 => {
-                        let mapping = Mapping2D::from_params(
-                            p,
-                            &(self.render_from_world * td.world_from_texture),
-                            loc,
-                        )?;
-                        let closed_form = match p.string("aamode")? {
-                            Some("none") => false,
-                            None | Some("closedform") => true,
-                            Some(other) => {
-                                let at = p.get("aamode").map_or(loc, |x| &x.loc);
-                                self.warn_once(
-                                    format!("aamode {other}"),
-                                    at,
-                                    format!(
-                                        "checkerboard antialiasing mode \"{other}\" is unknown \
-                                         (none or closedform); closedform is used, as pbrt-v3 \
-                                         does"
-                                    ),
-                                );
-                                true
-                            }
-                        };
-                        Texture::Checkerboard2D {
-                            mapping,
-                            tex1,
-                            tex2,
-                            closed_form,
-                        }
-                    }
-                    3 => Texture::Checkerboard3D {
-                        texture_from_world: self.texture_from_render_3d(td.world_from_texture),
-                        tex1,
-                        tex2,
-                    },
-                    d => {
-                        let at = p.get("dimension").map_or(loc, |x| &x.loc);
-                        return Err(Error::at(
-                            at,
-                            format!(
-                                "{d}-dimensional checkerboard texture is not supported (2 or 3)"
-                            ),
-                        ));
-                    }
-                }
-            }
-            "imagemap" => {
-                let mapping = Mapping2D::from_params(
-                    p,
-                    &(self.render_from_world * td.world_from_texture),
-                    loc,
-                )?;
-                let image = self.image_map::<T>(p, loc)?;
-                Texture::Image { mapping, image }
-            }
-            "bilerp" => {
-                let mapping = Mapping2D::from_params(
-                    p,
-                    &(self.render_from_world * td.world_from_texture),
-                    loc,
-                )?;
-                let mut v = [T::ZERO, T::ONE, T::ZERO, T::ONE];
-                for (slot, name) in v.iter_mut().zip(["v00", "v01", "v10", "v11"]) {
-                    if let Some(c) = self.param_opt::<T>(p, name)?.and_then(|t| t.as_constant()) {
-                        *slot = c;
-                    }
-                }
-                Texture::Bilerp { mapping, v }
-            }
+            "checkerboard" => self.checkerboard(td)?,
+            "imagemap" => Texture::Image {
+                mapping: self.mapping_2d(td)?,
+                image: self.image_map::<T>(p, loc)?,
+            },
+            "bilerp" => self.bilerp(td)?,
             "uv" if T::kind() == TextureValue::Spectrum => Texture::Uv {
-                mapping: Mapping2D::from_params(
-                    p,
-                    &(self.render_from_world * td.world_from_texture),
-                    loc,
-                )?,
+                mapping: self.mapping_2d(td)?,
             },
             "uv" => {
                 return Err(Error::at(
@@ -449,28 +389,12 @@ impl<'a> TextureBuilder<'a> {
                     "the \"uv\" texture is a spectrum texture; pbrt-v3 has no float one",
                 ))
             }
-            "fbm" | "wrinkled" | "windy" | "marble" => {
-                let kind = td.plugin.kind.as_str();
-                if kind == "marble" && T::kind() != TextureValue::Spectrum {
-                    return Err(Error::at(
-                        loc,
-                        "the \"marble\" texture is a spectrum texture; pbrt-v3 has no float one",
-                    ));
-                }
-                Texture::Noise {
-                    texture_from_render: self.texture_from_render_3d(td.world_from_texture),
-                    pattern: noise_pattern(kind, p)?,
-                }
-            }
+            "fbm" | "wrinkled" | "windy" | "marble" => self.noise(td)?,
             // pbrt-v3 hands its "inside" parameter to the texture's outside and "outside" to
             // its dots (`CreateDotsFloatTexture` against the constructor's order): the images
             // people have show it so, and so does acr.
             "dots" => Texture::Dots {
-                mapping: Mapping2D::from_params(
-                    p,
-                    &(self.render_from_world * td.world_from_texture),
-                    loc,
-                )?,
+                mapping: self.mapping_2d(td)?,
                 inside: self.param_or(p, "outside", T::ZERO)?,
                 outside: self.param_or(p, "inside", T::ONE)?,
             },
@@ -493,12 +417,94 @@ impl<'a> TextureBuilder<'a> {
                     format!("unknown texture class \"{other}\"{hint}"),
                 ));
             }
-        };
-        let tex = Arc::new(tex);
-        if let Some(slot) = T::cache(self).get_mut(index) {
-            *slot = Some(Arc::clone(&tex));
+        })
+    }
+
+    /// The 2D mapping of `td`'s parameters, from render space.
+    fn mapping_2d(&self, td: &TextureDesc) -> Result<Mapping2D> {
+        Mapping2D::from_params(
+            &td.plugin.params,
+            &(self.render_from_world * td.world_from_texture),
+            &td.plugin.loc,
+        )
+    }
+
+    /// A `checkerboard`: 2D (its antialiasing mode read) or 3D.
+    fn checkerboard<T: Build>(&mut self, td: &TextureDesc) -> Result<Texture<T>> {
+        let p = &td.plugin.params;
+        let loc = &td.plugin.loc;
+        let tex1 = self.param_or(p, "tex1", T::ONE)?;
+        let tex2 = self.param_or(p, "tex2", T::ZERO)?;
+        match p.int_or("dimension", 2)? {
+            2 => Ok(Texture::Checkerboard2D {
+                mapping: self.mapping_2d(td)?,
+                tex1,
+                tex2,
+                closed_form: self.closed_form(p, loc)?,
+            }),
+            3 => Ok(Texture::Checkerboard3D {
+                texture_from_world: self.texture_from_render_3d(td.world_from_texture),
+                tex1,
+                tex2,
+            }),
+            d => {
+                let at = p.get("dimension").map_or(loc, |x| &x.loc);
+                Err(Error::at(
+                    at,
+                    format!("{d}-dimensional checkerboard texture is not supported (2 or 3)"),
+                ))
+            }
         }
-        Ok(tex)
+    }
+
+    /// Whether a 2D checkerboard is antialiased in closed form (`aamode`): an unknown mode
+    /// warns and is closed form, as in pbrt-v3.
+    fn closed_form(&mut self, p: &ParamList, loc: &Loc) -> Result<bool> {
+        Ok(match p.string("aamode")? {
+            Some("none") => false,
+            None | Some("closedform") => true,
+            Some(other) => {
+                let at = p.get("aamode").map_or(loc, |x| &x.loc);
+                self.warn_once(
+                    format!("aamode {other}"),
+                    at,
+                    format!(
+                        "checkerboard antialiasing mode \"{other}\" is unknown (none or \
+                         closedform); closedform is used, as pbrt-v3 does"
+                    ),
+                );
+                true
+            }
+        })
+    }
+
+    /// A `bilerp` between the constants at its four corners.
+    fn bilerp<T: Build>(&mut self, td: &TextureDesc) -> Result<Texture<T>> {
+        let p = &td.plugin.params;
+        let mapping = self.mapping_2d(td)?;
+        let mut v = [T::ZERO, T::ONE, T::ZERO, T::ONE];
+        for (slot, name) in v.iter_mut().zip(["v00", "v01", "v10", "v11"]) {
+            if let Some(c) = self.param_opt::<T>(p, name)?.and_then(|t| t.as_constant()) {
+                *slot = c;
+            }
+        }
+        Ok(Texture::Bilerp { mapping, v })
+    }
+
+    /// A 3D noise texture (`fbm`, `wrinkled`, `windy`, `marble`; `marble` is a spectrum
+    /// texture only).
+    fn noise<T: Build>(&mut self, td: &TextureDesc) -> Result<Texture<T>> {
+        let kind = td.plugin.kind.as_str();
+        if kind == "marble" && T::kind() != TextureValue::Spectrum {
+            return Err(Error::at(
+                &td.plugin.loc,
+                "the \"marble\" texture is a spectrum texture; pbrt-v3 has no float one",
+            ));
+        }
+        Ok(Texture::Noise {
+            texture_from_render: self.texture_from_render_3d(td.world_from_texture),
+            pattern: noise_pattern(kind, &td.plugin.params)?,
+        })
     }
 
     /// The MIP map an `imagemap` texture's parameters describe, read, converted and built

@@ -307,3 +307,73 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
     (line, col)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn manifest_errors_are_located() {
+        let dir = std::env::temp_dir().join(format!("acr-bench-manifest-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("m.toml");
+        std::fs::write(&p, "[budgets]\nspp = [1]\nbogus = 3\n").unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("m.toml:3:1:"), "{e}");
+        std::fs::write(
+            &p,
+            "[budgets]\nspp = [1]\n[[scene]]\nname = \"a\"\npath = \"a.pbrt\"\n\
+             reference = { method = \"nope\", spp = 4 }\n[[method]]\nlabel = \"x\"\n",
+        )
+        .unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("names method \"nope\""), "{e}");
+        for (section, message) in [
+            ("spp = [8]\nruns = 0", "sampler_cost runs 0 is out of range"),
+            ("spp = [0]", "sampler_cost budget 0 spp is out of range"),
+        ] {
+            std::fs::write(
+                &p,
+                format!(
+                    "[budgets]\nspp = [1]\n[sampler_cost]\n{section}\n[reference]\n\
+                     sampler = \"sobol\"\nspp = 4\n[[scene]]\nname = \"a\"\npath = \"a.pbrt\"\n\
+                     [[method]]\nlabel = \"x\"\n"
+                ),
+            )
+            .unwrap();
+            let e = read_manifest(&p).unwrap_err();
+            assert!(e.contains(message), "{e}");
+        }
+        // The time-limited runs' spp and a method's time plan: read, and checked.
+        let with = |budgets: &str, method: &str| {
+            format!(
+                "[budgets]\nspp = [1]\n{budgets}\n[reference]\nsampler = \"sobol\"\nspp = 4\n\
+                 [[scene]]\nname = \"a\"\npath = \"a.pbrt\"\n[[method]]\nlabel = \"x\"\n{method}\n"
+            )
+        };
+        std::fs::write(&p, with("time_limited_spp = 64", "time_plan = \"budget\"")).unwrap();
+        let m = read_manifest(&p).unwrap();
+        assert_eq!(m.budgets.time_limited_spp, Some(64));
+        assert_eq!(
+            m.methods[0].time_plan,
+            Some(crate::cli::render::TimePlan::Budget)
+        );
+        // Seeds to average over: listed once each.
+        for seeds in ["seeds = []", "seeds = [1, 2, 1]"] {
+            std::fs::write(&p, format!("{seeds}\n{}", with("", ""))).unwrap();
+            let e = read_manifest(&p).unwrap_err();
+            assert!(e.contains("seeds must list 1 to 64 different seeds"), "{e}");
+        }
+        std::fs::write(&p, format!("seeds = [4, 2]\n{}", with("", ""))).unwrap();
+        assert_eq!(read_manifest(&p).unwrap().run_seeds(), [4, 2]);
+        std::fs::write(&p, format!("seed = 5\n{}", with("", ""))).unwrap();
+        assert_eq!(read_manifest(&p).unwrap().run_seeds(), [5]);
+        std::fs::write(&p, with("time_limited_spp = 0", "")).unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("time_limited_spp is out of range"), "{e}");
+        std::fs::write(&p, with("", "time_plan = \"soon\"")).unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("m.toml:12:13:") && e.contains("fit"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

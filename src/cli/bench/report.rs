@@ -1,7 +1,34 @@
 //! What a bench writes: the CSVs, the Markdown report and the plots.
 
-use super::*;
+use super::{file_safe, BenchOptions, CostRow, Manifest, Measured, Method, Mode, Row};
+use std::fmt::Write as _;
+use std::path::Path;
 
+/// Writes what a bench of manifest `m` measured into `opts.out`: the CSVs, a plot per scene
+/// (a failed plot is only a warning) and the Markdown report.
+pub(super) fn write_results(
+    m: &Manifest,
+    manifest_path: &Path,
+    opts: &BenchOptions,
+    rows: &[Row],
+    costs: &[CostRow],
+) -> Result<(), String> {
+    write_csv(&opts.out.join("results.csv"), rows)?;
+    if m.sampler_cost.is_some() {
+        write_cost_csv(&opts.out.join("sampler_cost.csv"), costs)?;
+    }
+    for scene in &m.scenes {
+        let path = opts.out.join(format!("{}.png", file_safe(&scene.name)));
+        if let Err(e) = plot_scene(&path, &scene.name, &m.methods, rows) {
+            eprintln!("{}: plot failed: {e}", path.display());
+        }
+    }
+    let report = report_markdown(m, manifest_path, opts, rows, costs);
+    let path = opts.out.join("report.md");
+    std::fs::write(&path, report).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// `s` as one CSV field: quoted, its quotes doubled, when it holds a comma, quote or newline.
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
         format!("\"{}\"", s.replace('"', "\"\""))
@@ -103,6 +130,23 @@ pub fn report_markdown(
     costs: &[CostRow],
 ) -> String {
     let mut s = String::new();
+    write_setting(&mut s, m, manifest, opts);
+    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    if failed > 0 {
+        let _ = writeln!(s, "**{failed} runs failed**; see `results.csv`.\n");
+    }
+    for scene in &m.scenes {
+        write_scene_table(&mut s, m, &scene.name, rows);
+    }
+    if let Some(spec) = &m.sampler_cost {
+        write_cost_table(&mut s, spec.runs, costs);
+    }
+    s
+}
+
+/// The report's title and setting: manifest, command, machine, threads, commit, seeds, and
+/// what the figures mean.
+fn write_setting(s: &mut String, m: &Manifest, manifest: &Path, opts: &BenchOptions) {
     let _ = writeln!(s, "# {}\n", m.title.as_deref().unwrap_or("acr bench"));
     let _ = writeln!(s, "- manifest: `{}`", manifest.display());
     let _ = writeln!(s, "- command: `{}`", opts.command);
@@ -134,92 +178,127 @@ pub fn report_markdown(
         "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds as `--time-limit` (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
         m.methods[0].label
     );
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
-    if failed > 0 {
-        let _ = writeln!(s, "**{failed} runs failed**; see `results.csv`.\n");
-    }
-    for scene in &m.scenes {
-        let _ = writeln!(s, "## {}\n", scene.name);
-        let _ = writeln!(s, "![{0}]({0}.png)\n", file_safe(&scene.name));
-        let _ = writeln!(
-            s,
-            "| spp | method | seconds | MSE | relMSE | MSE ratio | relMSE ratio | mean / reference | equal-time seconds | equal-time spp | equal-time MSE | MSE ratio | relMSE ratio |"
-        );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-        for &spp in &m.budgets.spp {
-            let base = find(rows, &scene.name, &m.methods[0].label, spp, Mode::EqualSpp)
-                .and_then(|r| r.outcome.as_ref().ok());
-            for meth in &m.methods {
-                let eq = find(rows, &scene.name, &meth.label, spp, Mode::EqualSpp);
-                let et = find(rows, &scene.name, &meth.label, spp, Mode::EqualTime);
-                let mut line = format!("| {spp} | {} ", meth.label);
-                match eq.map(|r| &r.outcome) {
-                    Some(Ok(r)) => {
-                        let _ = write!(
-                            line,
-                            "| {:.3} | {:.3e} | {:.3e} | {} | {} | {:.4} ",
-                            r.seconds,
-                            r.metrics.mse,
-                            r.metrics.relmse,
-                            ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
-                            ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse)),
-                            mean_ratio(&r.metrics)
-                        );
-                    }
-                    Some(Err(_)) => line.push_str("| failed | | | | | "),
-                    None => line.push_str("| | | | | | "),
-                }
-                match et.map(|r| &r.outcome) {
-                    Some(Ok(r)) => {
-                        let _ = write!(
-                            line,
-                            "| {:.3} | {:.1} | {:.3e} | {} | {} |",
-                            r.seconds,
-                            r.spp_reached,
-                            r.metrics.mse,
-                            ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
-                            ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse))
-                        );
-                    }
-                    Some(Err(_)) => line.push_str("| failed | | | | |"),
-                    None => line.push_str("| | | | | |"),
-                }
-                let _ = writeln!(s, "{line}");
-            }
-        }
-        s.push('\n');
-    }
-    if let Some(spec) = &m.sampler_cost {
-        let _ = writeln!(s, "## The sampler's share of wall time\n");
-        let _ = writeln!(
-            s,
-            "`acr render --sampler-cost`, {} processes each (`sampler_cost.csv`): a render by a fresh sampler against a replay of its points, share = (render - replay) / render; the median over the processes, then the least and the largest.\n",
-            spec.runs
-        );
-        let _ = writeln!(
-            s,
-            "| scene | spp | method | share | least | largest | render s | replay s |"
-        );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
-        for c in costs {
-            let figures = match c.summary() {
-                Ok(c) => format!(
-                    "{:.1}% | {:.1}% | {:.1}% | {:.3} | {:.3}",
-                    100.0 * c.share,
-                    100.0 * c.least,
-                    100.0 * c.largest,
-                    c.rerender,
-                    c.replay
-                ),
-                Err(_) => "failed | | | |".to_owned(),
-            };
-            let _ = writeln!(s, "| {} | {} | {} | {figures} |", c.scene, c.spp, c.method);
-        }
-        s.push('\n');
-    }
-    s
 }
 
+/// A scene's section: its plot, and a line per budget and method.
+fn write_scene_table(s: &mut String, m: &Manifest, scene: &str, rows: &[Row]) {
+    let _ = writeln!(s, "## {scene}\n");
+    let _ = writeln!(s, "![{0}]({0}.png)\n", file_safe(scene));
+    let _ = writeln!(
+        s,
+        "| spp | method | seconds | MSE | relMSE | MSE ratio | relMSE ratio | mean / reference | equal-time seconds | equal-time spp | equal-time MSE | MSE ratio | relMSE ratio |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for &spp in &m.budgets.spp {
+        let base = find(rows, scene, &m.methods[0].label, spp, Mode::EqualSpp)
+            .and_then(|r| r.outcome.as_ref().ok());
+        for meth in &m.methods {
+            let eq = find(rows, scene, &meth.label, spp, Mode::EqualSpp);
+            let et = find(rows, scene, &meth.label, spp, Mode::EqualTime);
+            let mut line = format!("| {spp} | {} ", meth.label);
+            equal_spp_cells(&mut line, eq, base);
+            equal_time_cells(&mut line, et, base);
+            let _ = writeln!(s, "{line}");
+        }
+    }
+    s.push('\n');
+}
+
+/// The equal-spp cells of a method's line: seconds, errors, their ratios to `base`'s, the
+/// mean ratio.
+fn equal_spp_cells(line: &mut String, row: Option<&Row>, base: Option<&Measured>) {
+    match row.map(|r| &r.outcome) {
+        Some(Ok(r)) => {
+            let _ = write!(
+                line,
+                "| {:.3} | {:.3e} | {:.3e} | {} | {} | {:.4} ",
+                r.seconds,
+                r.metrics.mse,
+                r.metrics.relmse,
+                ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
+                ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse)),
+                mean_ratio(&r.metrics)
+            );
+        }
+        Some(Err(_)) => line.push_str("| failed | | | | | "),
+        None => line.push_str("| | | | | | "),
+    }
+}
+
+/// The equal-time cells of a method's line: seconds, spp reached, MSE, the ratios of its
+/// errors to `base`'s.
+fn equal_time_cells(line: &mut String, row: Option<&Row>, base: Option<&Measured>) {
+    match row.map(|r| &r.outcome) {
+        Some(Ok(r)) => {
+            let _ = write!(
+                line,
+                "| {:.3} | {:.1} | {:.3e} | {} | {} |",
+                r.seconds,
+                r.spp_reached,
+                r.metrics.mse,
+                ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
+                ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse))
+            );
+        }
+        Some(Err(_)) => line.push_str("| failed | | | | |"),
+        None => line.push_str("| | | | | |"),
+    }
+}
+
+/// The sampler-cost section: how it is measured (`runs` processes each), and a line per
+/// measure.
+fn write_cost_table(s: &mut String, runs: u32, costs: &[CostRow]) {
+    let _ = writeln!(s, "## The sampler's share of wall time\n");
+    let _ = writeln!(
+        s,
+        "`acr render --sampler-cost`, {runs} processes each (`sampler_cost.csv`): a render by a fresh sampler against a replay of its points, share = (render - replay) / render; the median over the processes, then the least and the largest.\n",
+    );
+    let _ = writeln!(
+        s,
+        "| scene | spp | method | share | least | largest | render s | replay s |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    for c in costs {
+        let figures = match c.summary() {
+            Ok(c) => format!(
+                "{:.1}% | {:.1}% | {:.1}% | {:.3} | {:.3}",
+                100.0 * c.share,
+                100.0 * c.least,
+                100.0 * c.largest,
+                c.rerender,
+                c.replay
+            ),
+            Err(_) => "failed | | | |".to_owned(),
+        };
+        let _ = writeln!(s, "| {} | {} | {} | {figures} |", c.scene, c.spp, c.method);
+    }
+    s.push('\n');
+}
+
+/// How many threads a run without `threads` uses: the machine's.
+fn available_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The CPU model and core count, from /proc/cpuinfo where there is one.
+fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_owned())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_owned());
+    format!(
+        "{model}, {} hardware threads, {}",
+        available_threads(),
+        std::env::consts::OS
+    )
+}
+
+/// `x` over `base` to three decimals; `-` without a positive base.
 fn ratio(x: f64, base: Option<f64>) -> String {
     match base {
         Some(b) if b > 0.0 => format!("{:.3}", x / b),

@@ -1,0 +1,196 @@
+//! The steps after the render: the image and the AOVs written, the stats, and the lines that
+//! tell how the render ended.
+
+use super::prepare::Job;
+use super::run::Rendered;
+use super::target::Target;
+use super::{Clock, RenderArgs, SamplerCost};
+use crate::cli::aov::write_aov;
+use crate::cli::output::{reached_spp, End};
+use crate::cli::stats::{peak_rss_mb, Seconds, Stats};
+use crate::geometry::Spectrum;
+use crate::render::Halt;
+
+/// Shows the final `image`, then writes it and the AOVs that have files of their own.
+pub(super) fn write_image_and_aovs(
+    args: &RenderArgs,
+    job: &Job,
+    target: &Target,
+    rendered: &mut Rendered,
+    image: &[Spectrum],
+    clock: &Clock,
+) -> Result<(), String> {
+    if let Some(d) = &rendered.display {
+        d.show(image);
+    }
+    let fit_partition = job.plugins.filter.fit_partition();
+    let out = &target.out;
+    if !out.writes_sums(rendered.signalled()) {
+        // The image is made; the sums would only raise the peak while the file is written.
+        rendered.film.release_sums();
+    }
+    let end = End {
+        spp: rendered.spp,
+        halted: rendered.counts.halted,
+        signalled: rendered.signalled(),
+        seconds: clock.render_seconds(),
+        features: rendered.features.as_ref(),
+    };
+    out.write_final(image, &rendered.film, &end)?;
+    let (w, h) = job.size();
+    for a in target.aovs.iter().filter(|a| !out.holds(a)) {
+        let line = write_aov(
+            a,
+            w as usize,
+            h as usize,
+            rendered.film.pixel_stats(),
+            job.plugins.sampler.partition(),
+            fit_partition.as_ref(),
+            rendered.features.as_ref(),
+        )?;
+        if !args.quiet {
+            eprintln!("{line}");
+        }
+    }
+    Ok(())
+}
+
+/// The run's statistics (`--stats`).
+pub(super) fn stats(
+    args: &RenderArgs,
+    job: &Job,
+    rendered: &Rendered,
+    cost: Option<SamplerCost>,
+    clock: &Clock,
+) -> Stats {
+    let (w, h) = job.size();
+    let counts = &rendered.counts;
+    let plugins = &job.plugins;
+    let render_s = clock.render_seconds();
+    let report = plugins.sampler.report();
+    Stats {
+        scene: args.scene.display().to_string(),
+        width: w,
+        height: h,
+        spp: rendered.spp,
+        samples: counts.samples,
+        rays: counts.rays,
+        threads: rayon::current_num_threads(),
+        seed: args.seed,
+        sampler: plugins.sampler.name().into(),
+        filter: plugins.reconstruction().into(),
+        integrator: plugins.integrator.name().into(),
+        halted: counts.halted,
+        halted_by: counts.halted_by.map(Halt::name),
+        dims: job
+            .scene
+            .dims
+            .names()
+            .into_iter()
+            .map(str::to_owned)
+            .collect(),
+        clusters: report.clusters,
+        cells: report.cells,
+        rounds: report.rounds,
+        fitted_by_degree: plugins.filter.report().fitted_by_degree,
+        dropped_samples: counts.dropped,
+        seconds: Seconds {
+            parse: (clock.parsed - clock.start).as_secs_f64(),
+            build: (clock.built - clock.parsed).as_secs_f64(),
+            render: render_s,
+            sampler: counts.sampler_seconds,
+            replay: cost.map(|c| c.replay),
+            rerender: cost.map(|c| c.render),
+            reconstruct: (clock.reconstructed - clock.measured).as_secs_f64(),
+            write: (clock.written - clock.reconstructed).as_secs_f64(),
+            total: clock.start.elapsed().as_secs_f64(),
+        },
+        mrays_per_s: if render_s > 0.0 {
+            counts.rays as f64 / render_s / 1e6
+        } else {
+            0.0
+        },
+        sampler_share: cost.map(|c| c.share),
+        peak_rss_mb: peak_rss_mb(),
+    }
+}
+
+/// Writes `stats` as JSON to the `--stats` file, if one is named.
+pub(super) fn write_stats(args: &RenderArgs, stats: &Stats) -> Result<(), String> {
+    if let Some(path) = &args.stats {
+        let json = serde_json::to_string_pretty(stats).map_err(|e| e.to_string())?;
+        std::fs::write(path, json + "\n")
+            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Tells how the render ended: the samples dropped, an interruption (an error, with how to
+/// resume), an early stop and the summary line (without `--quiet`).
+pub(super) fn report_end(
+    args: &RenderArgs,
+    target: &Target,
+    rendered: &Rendered,
+    stats: &Stats,
+) -> Result<(), String> {
+    let counts = &rendered.counts;
+    let output = &target.out.path;
+    let spp = rendered.spp;
+    if counts.dropped > 0 {
+        eprintln!(
+            "warning: {} of {} samples had NaN, infinite or negative radiance and were dropped",
+            counts.dropped, counts.samples
+        );
+    }
+    if rendered.signalled() {
+        return Err(interrupted(args, target, rendered));
+    }
+    if counts.halted && !args.quiet {
+        let why = match counts.halted_by {
+            Some(Halt::Noise) => "noise threshold",
+            _ => "time limit",
+        };
+        eprintln!(
+            "{why}: stopped after {} of {} samples per pixel",
+            counts.samples / (u64::from(stats.width) * u64::from(stats.height)).max(1),
+            spp
+        );
+    }
+    if !args.quiet {
+        eprintln!(
+            "{}: {}x{}, {spp} spp, {:.2} s render, {:.2} Mrays/s, {} threads -> {}",
+            args.scene.display(),
+            stats.width,
+            stats.height,
+            stats.seconds.render,
+            stats.mrays_per_s,
+            stats.threads,
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+/// The error of a render a signal stopped: how far it got, where the image so far is, and
+/// how to finish it.
+fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> String {
+    let spp = rendered.spp;
+    let reached = reached_spp(rendered.film.pixel_stats());
+    let resume = if target.out.can_merge {
+        format!(
+            "a mergeable EXR of sample indices {}..{}: render the rest with --sample-offset {} \
+             --spp {} --mergeable and `acr merge` the two",
+            args.sample_offset,
+            args.sample_offset + reached,
+            args.sample_offset + reached,
+            spp.saturating_sub(reached)
+        )
+    } else {
+        "render again to finish it".to_owned()
+    };
+    format!(
+        "interrupted by a signal after {reached} of {spp} samples per pixel; the image so far \
+         is in {} ({resume})",
+        target.out.path.display()
+    )
+}

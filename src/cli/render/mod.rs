@@ -1,0 +1,106 @@
+//! `acr render`: a scene to an image, with AOVs, statistics and the sampler-cost measure. The
+//! command is a sequence of named steps, one file each: prepare the scene and its plugins
+//! (`prepare.rs`), plan the output files (`target.rs`), render (`run.rs`), measure the
+//! sampler's cost (`sampler_cost.rs`), write the image, the AOVs and the stats (`finish.rs`).
+
+use std::time::Instant;
+
+mod args;
+mod finish;
+mod prepare;
+mod run;
+mod sampler_cost;
+mod target;
+
+pub use args::{RenderArgs, TimePlan};
+
+use prepare::Job;
+use run::Rendered;
+use sampler_cost::{SamplerCost, SamplerCostRun};
+use target::Target;
+
+/// When each step of a render ended, for the stats' seconds.
+struct Clock {
+    /// The command began.
+    start: Instant,
+    /// The scene files parsed.
+    parsed: Instant,
+    /// The scene built, its plugins chosen, its outputs planned.
+    built: Instant,
+    /// The render loop done.
+    rendered: Instant,
+    /// `--sampler-cost` measured.
+    measured: Instant,
+    /// The image reconstructed from the film.
+    reconstructed: Instant,
+    /// The image and AOVs written.
+    written: Instant,
+}
+
+impl Clock {
+    /// Every step at the start, now.
+    fn start() -> Self {
+        let now = Instant::now();
+        Self {
+            start: now,
+            parsed: now,
+            built: now,
+            rendered: now,
+            measured: now,
+            reconstructed: now,
+            written: now,
+        }
+    }
+
+    /// Seconds of the render itself (the film made, the samples traced).
+    fn render_seconds(&self) -> f64 {
+        (self.rendered - self.built).as_secs_f64()
+    }
+}
+
+/// Renders as `args` say.
+pub fn command(args: &RenderArgs) -> Result<(), String> {
+    let mut clock = Clock::start();
+    prepare::start_threads(args.threads)?;
+    let desc = prepare::read_scene(args)?;
+    clock.parsed = Instant::now();
+
+    let mut job = Job::prepare(args, desc)?;
+    let target = Target::plan(args, &job)?;
+    clock.built = Instant::now();
+
+    let mut rendered = run::render_scene(args, &mut job, &target)?;
+    clock.rendered = Instant::now();
+    let cost = measure_sampler_cost(args, &job, &mut rendered)?;
+    // The measure's renders are no part of the reconstruction.
+    clock.measured = Instant::now();
+
+    let image = job.plugins.image(&rendered.film);
+    clock.reconstructed = Instant::now();
+    finish::write_image_and_aovs(args, &job, &target, &mut rendered, &image, &clock)?;
+    clock.written = Instant::now();
+
+    let stats = finish::stats(args, &job, &rendered, cost, &clock);
+    finish::write_stats(args, &stats)?;
+    finish::report_end(args, &target, &rendered, &stats)
+}
+
+/// With `--sampler-cost`: the render's recorded batches replayed, alternating with fresh
+/// renders.
+fn measure_sampler_cost(
+    args: &RenderArgs,
+    job: &Job,
+    rendered: &mut Rendered,
+) -> Result<Option<SamplerCost>, String> {
+    let Some(batches) = rendered.batches.take() else {
+        return Ok(None);
+    };
+    let run = SamplerCostRun {
+        desc: &job.desc,
+        scene: &job.scene,
+        overrides: &job.overrides,
+        args,
+        film: &rendered.film,
+    };
+    run.measure(batches).map(Some)
+}

@@ -1,0 +1,175 @@
+//! The steps before the render: the worker threads started, the scene read and built, its
+//! plugins chosen and checked against the flags, the warnings printed.
+
+use super::RenderArgs;
+use crate::registry::{choose_for_scene, Overrides, Plugins};
+use crate::scene::Scene;
+use acr_parser::{SceneDescription, Warning};
+use acr_plugins::Setting;
+
+/// Starts `--threads` worker threads (without it, rayon starts one per core).
+pub(super) fn start_threads(threads: Option<u32>) -> Result<(), String> {
+    if let Some(n) = threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build_global()
+            .map_err(|e| format!("cannot start {n} threads: {e}"))?;
+    }
+    Ok(())
+}
+
+/// The scene file parsed, at a quarter of its resolution under `--quick`.
+pub(super) fn read_scene(args: &RenderArgs) -> Result<SceneDescription, String> {
+    let mut desc = acr_parser::parse_file(&args.scene).map_err(|e| e.to_string())?;
+    if args.quick {
+        quarter_resolution(&mut desc).map_err(|e| e.to_string())?;
+    }
+    Ok(desc)
+}
+
+/// What is rendered: the scene and the plugins chosen for it.
+pub(super) struct Job {
+    /// The scene as parsed.
+    pub(super) desc: SceneDescription,
+    /// The scene built.
+    pub(super) scene: Scene,
+    /// The command line's choices of plugins and their parameters.
+    pub(super) overrides: Overrides,
+    /// The sampler, filter and integrator.
+    pub(super) plugins: Plugins,
+    /// Whether the film splats each sample with the filter's kernel (neither the filter's
+    /// cells nor the sampler make the image).
+    pub(super) splats: bool,
+}
+
+impl Job {
+    /// Builds the scene with the command line's crop, chooses its plugins, checks them against
+    /// `--sample-offset` and `--mergeable`, and prints the warnings.
+    pub(super) fn prepare(args: &RenderArgs, desc: SceneDescription) -> Result<Job, String> {
+        let spp = if args.quick { Some(1) } else { args.spp };
+        let mut warnings = desc.warnings.clone();
+        let scene = build_scene(args, &desc, &mut warnings)?;
+        let overrides = overrides(args)?;
+        let mut plugins =
+            choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
+                .map_err(|e| e.to_string())?;
+        start_at_sample_offset(args.sample_offset, &mut plugins)?;
+        let splats = plugins.filter.cell_layout().is_none() && !plugins.sampler.reconstructs();
+        if args.mergeable && (!splats || plugins.sampler.streams() > 1) {
+            return Err(format!(
+                "--mergeable needs a splatting filter (box, gaussian, mitchell, sinc, triangle) \
+                 and a sampler that does not reconstruct the image itself, not {} + {}",
+                plugins.sampler.name(),
+                plugins.filter.name()
+            ));
+        }
+        print_warnings(&desc, warnings);
+        Ok(Job {
+            desc,
+            scene,
+            overrides,
+            plugins,
+            splats,
+        })
+    }
+
+    /// The film's crop size, in pixels.
+    pub(super) fn size(&self) -> (u32, u32) {
+        self.scene.film.size()
+    }
+}
+
+/// The scene built, cropped by `--cropwindow` or `--pixelbounds`.
+fn build_scene(
+    args: &RenderArgs,
+    desc: &SceneDescription,
+    warnings: &mut Vec<Warning>,
+) -> Result<Scene, String> {
+    let mut scene = Scene::build(desc, warnings).map_err(|e| e.to_string())?;
+    if let Some(w) = args.cropwindow {
+        scene
+            .film
+            .set_crop_window(w)
+            .map_err(|e| format!("--cropwindow {e}"))?;
+    }
+    if let Some(b) = args.pixelbounds {
+        scene
+            .film
+            .set_pixel_bounds(b)
+            .map_err(|e| format!("--pixelbounds {e}"))?;
+    }
+    Ok(scene)
+}
+
+/// The plugins and parameters the command line names.
+fn overrides(args: &RenderArgs) -> Result<Overrides, String> {
+    Ok(Overrides {
+        sampler: args.sampler.clone(),
+        filter: args.filter.clone(),
+        integrator: args.integrator.clone(),
+        settings: args
+            .set
+            .iter()
+            .map(|s| Setting::parse(s))
+            .collect::<Result<_, _>>()
+            .map_err(|e| e.to_string())?,
+    })
+}
+
+/// `--sample-offset`: the sampler's samples start at index `offset`, where it can.
+fn start_at_sample_offset(offset: u32, plugins: &mut Plugins) -> Result<(), String> {
+    if offset == 0 {
+        return Ok(());
+    }
+    let fits = plugins.sampler.spp().checked_add(offset).is_some();
+    if !fits || !plugins.sampler.set_sample_offset(offset) {
+        return Err(format!(
+            "--sample-offset {offset}: the {} sampler cannot start its samples there (sample \
+             ranges need a sampler whose points depend on the index alone: random or sobol)",
+            plugins.sampler.name()
+        ));
+    }
+    Ok(())
+}
+
+/// Prints the scene's warnings and those of its unused parameters, each once.
+fn print_warnings(desc: &SceneDescription, mut warnings: Vec<Warning>) {
+    if let Some(a) = &desc.accelerator {
+        // acr has one acceleration structure; pbrt-v3's choice of its own is moot.
+        for p in a.params.iter() {
+            p.mark_used();
+        }
+    }
+    warnings.extend(desc.unused_parameter_warnings());
+    // A file included twice repeats its warnings word for word: print each once.
+    let mut printed = std::collections::HashSet::new();
+    for w in &warnings {
+        let text = w.to_string();
+        if printed.insert(text.clone()) {
+            eprintln!("{text}");
+        }
+    }
+}
+
+/// `--quick`: the Film's resolution divided by 4 in each direction (at least 1 pixel), as
+/// pbrt-v4 does; a scene without a Film gets pbrt-v3's default 1280x720, quartered.
+fn quarter_resolution(desc: &mut SceneDescription) -> acr_parser::Result<()> {
+    use acr_parser::{Param, ParamList, ParamType, PluginDesc, Values};
+    let loc = match (&desc.film, &desc.camera) {
+        (Some(f), _) => f.loc.clone(),
+        (None, Some(c)) => c.plugin.loc.clone(),
+        (None, None) => return Ok(()),
+    };
+    let film = desc.film.get_or_insert_with(|| PluginDesc {
+        kind: "image".to_owned(),
+        params: ParamList::new(),
+        loc: loc.clone(),
+    });
+    for (name, default) in [("xresolution", 1280), ("yresolution", 720)] {
+        let v = film.params.int_or(name, default)?;
+        let quarter = Values::Ints(vec![(v / 4).max(1)]);
+        film.params
+            .push(Param::new(ParamType::Integer, name, quarter, loc.clone()));
+    }
+    Ok(())
+}

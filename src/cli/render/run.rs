@@ -1,0 +1,232 @@
+//! The render itself: the progress bar, the signals that stop it, the partial images and the
+//! display that look at it, and the render loop.
+
+use super::prepare::Job;
+use super::target::Target;
+use super::{RenderArgs, TimePlan};
+use crate::cli::aov::AovRequest;
+use crate::cli::display::Display;
+use crate::cli::output::Output;
+use crate::cli::replay::Recording;
+use crate::first_hit::FeatureImage;
+use crate::render::{render_with_features, Checkpoint, Halt, RenderCounts, Stop};
+use acr_plugins::{Film, SamplePoint, Sampler};
+use std::io::IsTerminal;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// What a render made.
+pub(super) struct Rendered {
+    /// The film, its samples added.
+    pub(super) film: Film,
+    /// What the render loop counted, and why it stopped.
+    pub(super) counts: RenderCounts,
+    /// The first-hit features, when an AOV needs them.
+    pub(super) features: Option<FeatureImage>,
+    /// The viewer the image is shown in (`--display-server`).
+    pub(super) display: Option<Display>,
+    /// The sampler's batches, recorded under `--sampler-cost`.
+    pub(super) batches: Option<Vec<Vec<SamplePoint>>>,
+    /// Samples per pixel planned.
+    pub(super) spp: u32,
+}
+
+impl Rendered {
+    /// Whether SIGINT or SIGTERM stopped the render.
+    pub(super) fn signalled(&self) -> bool {
+        self.counts.halted_by == Some(Halt::Signal)
+    }
+}
+
+/// Renders `job` into a fresh film, with a progress bar on a terminal, stopped by the time
+/// limit, the noise threshold or a signal, showing partial images as `args` ask.
+pub(super) fn render_scene(
+    args: &RenderArgs,
+    job: &mut Job,
+    target: &Target,
+) -> Result<Rendered, String> {
+    let mut film = job.plugins.film(&job.scene);
+    let bar = progress_bar(args.quiet);
+    let spp = job.plugins.sampler.spp();
+    if let Some(t) = args.noise_threshold {
+        // An adaptive sampler that can stops where it is settled; the render loop's global
+        // check stops any sampler.
+        job.plugins.sampler.stop_at_noise(t, args.min_spp);
+    }
+    let mut recording = Recording::new(job.plugins.sampler.as_mut());
+    let sampler: &mut dyn Sampler = if args.sampler_cost {
+        &mut recording
+    } else {
+        recording.inner()
+    };
+    let interrupted = watch_signals()?;
+    let looks = Looks {
+        out: &target.out,
+        display: connect_display(args, target, job.scene.film.size()),
+    };
+    let write_partial = |film: &Film, seconds: f64| looks.write_partial(film, seconds);
+    let show = |film: &Film, _: f64| looks.show(film);
+    let stop = stop_rules(args, &interrupted, &write_partial, &show, &looks);
+    let mut features = target.aovs.iter().any(AovRequest::is_feature).then(|| {
+        let [x0, x1, y0, y1] = job.scene.film.crop;
+        FeatureImage::new(x0, x1, y0, y1)
+    });
+    let counts = render_with_features(
+        &job.scene,
+        &job.plugins.integrator,
+        sampler,
+        &mut film,
+        args.seed,
+        &stop,
+        bar.as_ref(),
+        features.as_mut(),
+    );
+    warn_of_non_finite_features(features.as_ref(), &counts);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let batches = args.sampler_cost.then(|| recording.into_batches());
+    Ok(Rendered {
+        film,
+        counts,
+        features,
+        display: looks.display,
+        batches,
+        spp,
+    })
+}
+
+/// What looks at the image as it renders: the partial images written to the output, the
+/// viewer it is shown in.
+struct Looks<'t> {
+    /// The output the partial images go to.
+    out: &'t Output,
+    /// The viewer (`--display-server`), if it answered.
+    display: Option<Display>,
+}
+
+impl Looks<'_> {
+    /// Writes the image so far to the output (`--write-partial-images`); a failure is a
+    /// warning.
+    fn write_partial(&self, film: &Film, seconds: f64) {
+        if let Err(e) = self.out.write_partial(film, seconds) {
+            eprintln!("warning: partial image: {e}");
+        }
+    }
+
+    /// Shows the film's image so far in the viewer, if there is one.
+    fn show(&self, film: &Film) {
+        if let Some(d) = &self.display {
+            let scale = film.settings().scale;
+            d.show(
+                &film
+                    .pixels()
+                    .into_iter()
+                    .map(|c| c * scale)
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+}
+
+/// The viewer at `--display-server`, shown the output's name and an image of `size`.
+fn connect_display(args: &RenderArgs, target: &Target, size: (u32, u32)) -> Option<Display> {
+    args.display_server.as_deref().and_then(|address| {
+        let name = target
+            .out
+            .path
+            .file_name()
+            .map_or_else(|| "acr".to_owned(), |n| n.to_string_lossy().into_owned());
+        Display::connect(address, &name, size.0 as usize, size.1 as usize)
+    })
+}
+
+/// When the render stops early (`interrupted`, the time limit, the noise threshold) and what
+/// looks at it on the way: `write_partial` under `--write-partial-images`, `show` every
+/// second when `looks` has a viewer.
+fn stop_rules<'a>(
+    args: &RenderArgs,
+    interrupted: &'a AtomicBool,
+    write_partial: &'a (dyn Fn(&Film, f64) + Sync),
+    show: &'a (dyn Fn(&Film, f64) + Sync),
+    looks: &Looks,
+) -> Stop<'a> {
+    let mut checkpoints = Vec::new();
+    if let Some(s) = args.write_partial_images {
+        checkpoints.push(Checkpoint {
+            every: Duration::from_secs_f64(s),
+            whole_passes: true,
+            look: write_partial,
+        });
+    }
+    if looks.display.is_some() {
+        checkpoints.push(Checkpoint {
+            every: Duration::from_secs(1),
+            whole_passes: false,
+            look: show,
+        });
+    }
+    Stop {
+        time_limit: args.time_limit.map(Duration::from_secs_f64),
+        noise_threshold: args.noise_threshold,
+        min_spp: args.min_spp,
+        plan_to_time: args.time_plan == TimePlan::Fit,
+        interrupt: Some(interrupted),
+        checkpoints,
+    }
+}
+
+/// A progress bar of the samples traced, on a terminal and without `--quiet`.
+fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
+    let show_progress = !quiet && std::io::stderr().is_terminal();
+    show_progress.then(|| {
+        let b = indicatif::ProgressBar::new(0);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{wide_bar}] {percent}% samples, eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    })
+}
+
+/// SIGINT and SIGTERM (what a scheduler sends before it kills) set the flag returned, which
+/// ends the render at the end of the pass under way; a second one exits at once.
+#[cfg(unix)]
+fn watch_signals() -> Result<Arc<AtomicBool>, String> {
+    let interrupted = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(signal, 1, Arc::clone(&interrupted))
+            .and_then(|_| signal_hook::flag::register(signal, Arc::clone(&interrupted)))
+            .map_err(|e| format!("cannot watch for signals: {e}"))?;
+    }
+    Ok(interrupted)
+}
+
+/// On systems other than Unix nothing watches for signals: the flag returned is never set,
+/// and Ctrl-C ends the process at once, without writing the image so far.
+#[cfg(not(unix))]
+fn watch_signals() -> Result<Arc<AtomicBool>, String> {
+    Ok(Arc::new(AtomicBool::new(false)))
+}
+
+/// Warns of samples whose first-hit features were not finite: left out of the feature AOVs,
+/// taken as 0 by the polynomial fit's cells.
+fn warn_of_non_finite_features(features: Option<&FeatureImage>, counts: &RenderCounts) {
+    if let Some(f) = features.filter(|f| f.non_finite > 0) {
+        eprintln!(
+            "warning: {} samples had non-finite first-hit features; they are left out of the \
+             feature AOVs",
+            f.non_finite
+        );
+    }
+    if counts.non_finite_features > 0 {
+        eprintln!(
+            "warning: {} samples had non-finite first-hit features; the polynomial fit's cells \
+             took them as 0",
+            counts.non_finite_features
+        );
+    }
+}
