@@ -47,8 +47,14 @@ impl FourierTable {
         if let Some(t) = tables.get(path) {
             return Ok(t);
         }
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let bytes = acr_parser::source::read_file(path, acr_parser::source::FileKind::BsdfTable)
+            .map_err(|e| {
+                format!(
+                    "cannot read {}: {}",
+                    path.display(),
+                    acr_parser::io_message(&e)
+                )
+            })?;
         let table: &'static FourierTable = Box::leak(Box::new(
             Self::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?,
         ));
