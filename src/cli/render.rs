@@ -188,6 +188,8 @@ struct SamplerCost {
     /// The median over pairs of (render - replay) / render, each pair run back to back: the
     /// machine's drift cancels within a pair.
     share: f64,
+    /// Each pair's [render, replay], in the order run.
+    pairs: [[f64; 2]; SamplerCostRun::PAIRS],
 }
 
 /// What `--sampler-cost` needs to render the scene again, and the first render's film.
@@ -238,7 +240,9 @@ impl SamplerCostRun<'_> {
             .zip(&replays)
             .map(|(r, p)| (r - p) / r.max(1e-9))
             .collect();
+        let pairs = std::array::from_fn(|i| [renders[i], replays[i]]);
         Ok(SamplerCost {
+            pairs,
             render: median(&mut renders),
             replay: median(&mut replays),
             share: median(&mut shares).max(0.0),
@@ -624,6 +628,7 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
             0.0
         },
         sampler_share: cost.map(|c| c.share),
+        sampler_cost_pairs: cost.map(|c| c.pairs),
         peak_rss_mb: peak_rss_mb(),
     };
     if let Some(path) = &args.stats {
