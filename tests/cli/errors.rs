@@ -172,13 +172,15 @@ fn a_device_named_as_any_scene_file_is_refused_at_once() {
     for name in ["zero.png", "zero.exr"] {
         std::os::unix::fs::symlink("/dev/zero", dir.join(name)).unwrap();
     }
-    let world = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+    let world = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\" Film \"image\" \
+                 \"integer xresolution\" 8 \"integer yresolution\" 8\nWorldBegin\n";
     for (what, line) in [
         ("Include", "Include \"/dev/zero\""),
         ("PLY", "Shape \"plymesh\" \"string filename\" \"/dev/zero\""),
         (
             "image texture",
-            "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"zero.png\"",
+            "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"zero.png\"\n\
+             Material \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"",
         ),
         (
             "image light",
