@@ -140,6 +140,11 @@ fn decode_with_image_crate(data: &[u8], format: &str) -> Result<RgbImage, String
 /// fails here instead of sizing an allocation.
 pub const MAX_IMAGE_PIXELS: usize = 1 << 28;
 
+/// The most an EXR's raw samples may outweigh its file: deflate (the ZIP compressions) gains
+/// at most about 1032:1, the others less; a header claiming more is corrupt or hostile, and is
+/// refused before its pixels are allocated (a 1 KB file made `acr merge` allocate 1.9 GB).
+const MAX_EXR_RATIO: usize = 1100;
+
 /// An EXR's header, read before its pixels: every layer's size and the display window
 /// (which `acr merge` allocates) must be sane first.
 pub fn exr_header(data: &[u8]) -> Result<exr::meta::MetaData, String> {
@@ -151,15 +156,23 @@ pub fn exr_header(data: &[u8]) -> Result<exr::meta::MetaData, String> {
     )?;
     for h in meta.headers.iter() {
         let display = h.shared_attributes.display_window.size;
-        for (w, ht) in [
-            (h.layer_size.width(), h.layer_size.height()),
-            (display.width(), display.height()),
-        ] {
+        let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+        for (w, ht) in [(w, ht), (display.width(), display.height())] {
             if w.checked_mul(ht).is_none_or(|n| n > MAX_IMAGE_PIXELS) {
                 return Err(format!(
                     "the image is {w}x{ht}, more than {MAX_IMAGE_PIXELS} pixels"
                 ));
             }
+        }
+        // Its samples at 2 bytes each at least, against what the file could hold compressed.
+        let channels = h.channels.list.len().max(1);
+        let raw = w * ht * channels * 2;
+        if raw / MAX_EXR_RATIO > data.len() {
+            return Err(format!(
+                "its header claims {w}x{ht} pixels of {channels} channels, more than a file of \
+                 {} bytes can hold",
+                data.len()
+            ));
         }
     }
     Ok(meta)
@@ -495,6 +508,18 @@ mod tests {
             }
         }
         img
+    }
+
+    /// A 1 KB EXR (found by the `merge` fuzz target) whose header claims a 1 GB image: refused
+    /// from its header, before the pixels are allocated.
+    #[test]
+    fn an_exr_claiming_more_than_its_file_can_hold_is_refused_before_allocating() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/merge/huge-claimed-size.exr");
+        let data = std::fs::read(path).unwrap();
+        assert!(data.len() < 10_000);
+        let e = decode_image(&data, "exr", false).unwrap_err();
+        assert!(e.contains("more than a file of"), "{e}");
     }
 
     #[test]
