@@ -1,5 +1,6 @@
 //! Scene-graph snapshots (insta) of every scene in scenes/, of targeted features, and of the
-//! error messages; plus the public pbrt-v3 scenes in ../shared and the `acr parse` command.
+//! error messages; the pbrt-v3 scenes that ship (and, ignored unless asked for, those only
+//! ../shared holds); the `acr parse` command.
 
 use acr::parser::{parse_file, parse_str};
 use std::path::{Path, PathBuf};

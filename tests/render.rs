@@ -1,5 +1,6 @@
 //! Rendering tests: every example scene renders; analytic cases converge to their known values;
-//! acr agrees with pbrt-v3's own renders of the public scenes in ../shared.
+//! acr agrees with pbrt-v3's own renders of the public scenes in scenes/pbrt-v3/public (and,
+//! ignored unless asked for, of those only ../shared holds).
 
 use acr::geometry::Spectrum;
 use acr::parser::{parse_file, parse_str, Param, ParamType, SceneDescription, Values};
