@@ -164,13 +164,27 @@ pub fn exr_header(data: &[u8]) -> Result<exr::meta::MetaData, String> {
                 ));
             }
         }
-        // Its samples at 2 bytes each at least, against what the file could hold compressed.
+        // Its samples at 2 bytes each at least, and one block of them (which the reader
+        // allocates whole), against what the file could hold compressed.
         let channels = h.channels.list.len().max(1);
         let raw = w * ht * channels * 2;
         if raw / MAX_EXR_RATIO > data.len() {
             return Err(format!(
                 "its header claims {w}x{ht} pixels of {channels} channels, more than a file of \
                  {} bytes can hold",
+                data.len()
+            ));
+        }
+        let block_pixels = match h.blocks {
+            exr::meta::BlockDescription::Tiles(t) => t.tile_size.area(),
+            exr::meta::BlockDescription::ScanLines => {
+                h.compression.scan_lines_per_block().saturating_mul(w)
+            }
+        };
+        let block = block_pixels.saturating_mul(h.channels.bytes_per_pixel);
+        if block / MAX_EXR_RATIO > data.len() {
+            return Err(format!(
+                "its header claims blocks of {block} bytes, more than a file of {} bytes can hold",
                 data.len()
             ));
         }
@@ -518,6 +532,17 @@ mod tests {
             .join("fuzz/regressions/merge/huge-claimed-size.exr");
         let data = std::fs::read(path).unwrap();
         assert!(data.len() < 10_000);
+        let e = decode_image(&data, "exr", false).unwrap_err();
+        assert!(e.contains("more than a file of"), "{e}");
+    }
+
+    /// A 918-byte EXR (found by the `merge` fuzz target) whose header claims blocks of 2 GB,
+    /// which the EXR reader allocates whole: refused from its header.
+    #[test]
+    fn an_exr_claiming_huge_blocks_is_refused_before_allocating() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/merge/huge-claimed-block.exr");
+        let data = std::fs::read(path).unwrap();
         let e = decode_image(&data, "exr", false).unwrap_err();
         assert!(e.contains("more than a file of"), "{e}");
     }

@@ -45,7 +45,7 @@ const KEPT: &[(&str, Check, usize)] = &[
     ("scene", cases::scene, 1),
     ("render", cases::render, 0),
     ("fourier", cases::fourier, 1),
-    ("merge", cases::merge, 1),
+    ("merge", cases::merge, 2),
 ];
 
 #[test]
