@@ -26,6 +26,74 @@ pub fn ply(data: &[u8]) {
     }
 }
 
+/// A `.bsdf` table (the `fourier` material's `bsdffile`): a table or an error, never a panic;
+/// a table of modest finite numbers evaluates, samples and gives densities without NaN.
+pub fn fourier(data: &[u8]) {
+    use acr::fourier::{FourierBsdf, FourierTable};
+    use acr::geometry::Vec3;
+    let Ok(table) = FourierTable::parse(data) else {
+        return;
+    };
+    // Huge or non-finite coefficients overflow pbrt-v3's arithmetic as they would ours; the
+    // check is for tables a layered-BSDF tool could write.
+    let modest = data
+        .get(64..)
+        .unwrap_or_default()
+        .chunks_exact(4)
+        .all(|w| f32::from_le_bytes([w[0], w[1], w[2], w[3]]).abs() <= 1e4)
+        && table.eta.is_finite();
+    // The material keeps tables for the process's life; this one is reclaimed below so that
+    // the fuzzer's leak check stays meaningful.
+    let table: &'static FourierTable = Box::leak(Box::new(table));
+    let bsdf = FourierBsdf { table };
+    let dirs = [
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(0.6, 0.0, 0.8),
+        Vec3::new(0.0, -0.6, -0.8),
+        Vec3::new(0.48, 0.6, 0.64),
+        Vec3::new(1.0, 0.0, 0.0),
+    ];
+    for &wo in &dirs {
+        for &wi in &dirs {
+            let (f, pdf) = (bsdf.f(wo, wi), bsdf.pdf(wo, wi));
+            assert!(!modest || !(f.x.is_nan() || f.y.is_nan() || f.z.is_nan() || pdf.is_nan()));
+        }
+        for u in [[0.1, 0.2], [0.5, 0.5], [0.99, 0.01]] {
+            if let Some((wi, f, pdf)) = bsdf.sample_f(wo, u) {
+                let nan = wi.x.is_nan() || f.x.is_nan() || f.y.is_nan() || f.z.is_nan();
+                assert!(!modest || !(nan || pdf.is_nan()), "sampled NaN");
+            }
+        }
+    }
+    // SAFETY: `table` came from `Box::leak` above and `bsdf`, its only user, is not used again.
+    drop(unsafe { Box::from_raw(table as *const FourierTable as *mut FourierTable) });
+}
+
+/// `acr merge`'s inputs: an EXR's bytes read as a crop placed in its frame and as a mergeable
+/// EXR's sums, or an error, never a panic; a crop lies within its frame, and sums added to
+/// themselves double.
+pub fn merge(data: &[u8]) {
+    if let Ok((crop, frame)) = acr::image_io::decode_image_with_frame(data, "exr") {
+        assert!(frame.x0 + crop.width <= frame.width && frame.y0 + crop.height <= frame.height);
+        assert!(frame.width.saturating_mul(frame.height) <= acr::image_io::MAX_IMAGE_PIXELS);
+        assert_eq!(crop.pixels.len(), crop.width * crop.height);
+    }
+    let Ok(layer) = acr::exr_channels::Channels::decode(data) else {
+        return;
+    };
+    let f = layer.frame;
+    assert!(f.x0 + layer.width <= f.width && f.y0 + layer.height <= f.height);
+    let Some(sums) = acr::cli::mergeable::Sums::from_channels(layer) else {
+        return;
+    };
+    let n = sums.width * sums.height;
+    assert_eq!(sums.sums.len(), n);
+    let mut twice = sums.clone();
+    twice.add(&sums).expect("a crop merges with itself");
+    assert_eq!(twice.image().len(), n);
+    let _ = twice.variance();
+}
+
 /// Parse, build the scene (shapes, BVH, materials, textures, lights) and choose its plugins.
 pub fn scene(data: &[u8]) {
     let _ = built(data);

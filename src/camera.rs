@@ -123,6 +123,7 @@ impl Camera {
                 format!("shutterclose {shutter_close} is before shutteropen {shutter_open}"),
             ));
         }
+        check_degenerate(desc, projection, screen, frame, lens_radius, focal_distance)?;
 
         // pbrt-v3: camera -> screen (Perspective, or Orthographic(0, 1): the identity here),
         // screen -> raster.
@@ -235,6 +236,65 @@ impl Camera {
         }
         (o, d)
     }
+}
+
+/// Refuses what pbrt-v3 would take and render nothing sensible from: an empty, inverted or
+/// non-finite screen window (an all-black image), a frame aspect ratio that is not positive
+/// (the window it makes is empty), a negative or non-finite lens radius, a focal distance
+/// that is not positive with a lens, a shutter time that is not a number. Each at its
+/// parameter.
+fn check_degenerate(
+    desc: &CameraDesc,
+    projection: Projection,
+    screen: [f32; 4],
+    frame: f32,
+    lens_radius: f32,
+    focal_distance: f32,
+) -> Result<()> {
+    let p = &desc.plugin;
+    let params = &p.params;
+    let refuse = |name: &str, why: String| {
+        let loc = params.get(name).map_or(&p.loc, |x| &x.loc);
+        Err(Error::at(loc, why))
+    };
+    // The environment camera covers the sphere whatever its window (as pbrt-v3's).
+    if projection != Projection::Environment {
+        if params.get("screenwindow").is_none() && !(frame.is_finite() && frame > 0.0) {
+            return refuse(
+                "frameaspectratio",
+                format!("frameaspectratio {frame} is not a positive number"),
+            );
+        }
+        let [x0, x1, y0, y1] = screen;
+        if !(screen.iter().all(|v| v.is_finite()) && x0 < x1 && y0 < y1) {
+            return refuse(
+                "screenwindow",
+                format!(
+                    "screenwindow [{x0} {x1} {y0} {y1}] is empty or inverted: it needs \
+                     xmin < xmax and ymin < ymax (the image would be black)"
+                ),
+            );
+        }
+    }
+    if !(lens_radius.is_finite() && lens_radius >= 0.0) {
+        return refuse(
+            "lensradius",
+            format!("lensradius {lens_radius} is not a number >= 0"),
+        );
+    }
+    if lens_radius > 0.0 && !(focal_distance.is_finite() && focal_distance > 0.0) {
+        return refuse(
+            "focaldistance",
+            format!("focaldistance {focal_distance} is not a positive distance"),
+        );
+    }
+    for name in ["shutteropen", "shutterclose"] {
+        let t = params.float_or(name, 0.0)?;
+        if !t.is_finite() {
+            return refuse(name, format!("{name} {t} is not a finite time"));
+        }
+    }
+    Ok(())
 }
 
 /// pbrt's Perspective(fov, near, far): projective divide by z, then scale so that the field of
@@ -351,6 +411,63 @@ mod tests {
         for (x, y) in [(13.0, 7.0), (150.0, 80.0)] {
             assert!((at(x, y).length() - 1.0).abs() < 1e-5);
         }
+    }
+
+    #[test]
+    fn degenerate_camera_parameters_are_located_errors() {
+        let cases = [
+            (
+                "Camera \"orthographic\" \"float screenwindow\" [0 0 0 0]",
+                "screenwindow [0 0 0 0] is empty",
+            ),
+            (
+                "Camera \"perspective\" \"float screenwindow\" [1 -1 -1 1]",
+                "is empty or inverted",
+            ),
+            (
+                "Camera \"perspective\" \"float screenwindow\" [-1 1 1 1]",
+                "is empty or inverted",
+            ),
+            (
+                "Camera \"orthographic\" \"float frameaspectratio\" 0",
+                "frameaspectratio 0 is not a positive number",
+            ),
+            (
+                "Camera \"perspective\" \"float frameaspectratio\" -2",
+                "frameaspectratio -2 is not a positive number",
+            ),
+            (
+                "Camera \"perspective\" \"float fov\" 0",
+                "not between 0 and 180",
+            ),
+            (
+                "Camera \"perspective\" \"float fov\" 180",
+                "not between 0 and 180",
+            ),
+            (
+                "Camera \"perspective\" \"float lensradius\" -1",
+                "lensradius -1 is not a number >= 0",
+            ),
+            (
+                "Camera \"orthographic\" \"float lensradius\" 0.1 \"float focaldistance\" 0",
+                "focaldistance 0 is not a positive distance",
+            ),
+        ];
+        for (text, says) in cases {
+            let d = acr_parser::parse_str(text, Path::new("c.pbrt")).unwrap();
+            let e = Camera::new(d.camera.as_ref().unwrap(), (8, 8), glam::DMat4::IDENTITY)
+                .err()
+                .unwrap_or_else(|| panic!("{text}: accepted"));
+            assert!(e.to_string().contains(says), "{text}: {e}");
+            // At the parameter, not at the directive.
+            assert!(e.to_string().contains("c.pbrt:1:"), "{text}: {e}");
+            assert!(!e.to_string().contains("c.pbrt:1:1:"), "{text}: {e}");
+        }
+        // What the environment camera does not use is not checked.
+        camera(
+            "Camera \"environment\" \"float screenwindow\" [0 0 0 0]",
+            (8, 8),
+        );
     }
 
     #[test]

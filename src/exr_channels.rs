@@ -118,13 +118,21 @@ impl Channels {
     /// Reads the first layer of an EXR: every channel as f32, the integer and float
     /// attributes, and the crop's place in its display window.
     pub fn read(path: &Path) -> std::result::Result<Channels, String> {
+        let data = acr_parser::source::read_file(path, acr_parser::source::FileKind::Image)
+            .map_err(|e| acr_parser::io_message(&e))?;
+        Self::decode(&data)
+    }
+
+    /// The first layer of an EXR file's bytes, as [`Channels::read`] gives it.
+    pub fn decode(data: &[u8]) -> std::result::Result<Channels, String> {
+        crate::image_io::exr_header(data)?;
         let image = read()
             .no_deep_data()
             .largest_resolution_level()
             .all_channels()
             .first_valid_layer()
             .all_attributes()
-            .from_file(path)
+            .from_buffered(std::io::Cursor::new(data))
             .map_err(|e| e.to_string())?;
         let layer = &image.layer_data;
         let display = image.attributes.display_window;
@@ -182,7 +190,10 @@ impl Channels {
 /// The integer or float attribute `name` of an EXR's first layer, read from its header alone
 /// (`None` when the file has none, or is no EXR).
 pub fn read_attribute(path: &Path, name: &str) -> Option<Attribute> {
-    let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+    let (file, _) =
+        acr_parser::source::open_file(path, acr_parser::source::FileKind::Image).ok()?;
+    let meta =
+        exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false).ok()?;
     let header = meta.headers.first()?;
     let key = Text::from(name);
     let own = header.own_attributes.other.get(&key);

@@ -60,18 +60,39 @@ fn extension(path: &Path) -> String {
 /// as stored (what pbrt-v3's `ReadImage` does: its image textures apply their own "gamma"
 /// conversion, and its environment maps use PNG values as they are).
 pub fn read_image(path: &Path, srgb: bool) -> Result<RgbImage, String> {
-    let img = match extension(path).as_str() {
-        "png" => read_with_image_crate(path)?,
-        "exr" => read_exr(path)?,
-        "hdr" => read_with_image_crate(path)?,
-        "pfm" => read_pfm(path)?,
-        other => {
-            return Err(format!(
-                "unsupported image format \"{other}\" (acr reads .png, .exr, .hdr and .pfm)"
-            ))
-        }
+    let format = image_format(path)?;
+    decode_image(&read_image_file(path)?, format, srgb)
+}
+
+/// The bytes of an image file, through the checked reader every file a scene names goes
+/// through (a regular file of bounded size).
+fn read_image_file(path: &Path) -> Result<Vec<u8>, String> {
+    acr_parser::source::read_file(path, acr_parser::source::FileKind::Image)
+        .map_err(|e| acr_parser::io_message(&e))
+}
+
+/// The format of an image file, by its extension: `png`, `exr`, `hdr` or `pfm`.
+fn image_format(path: &Path) -> Result<&'static str, String> {
+    match extension(path).as_str() {
+        "png" => Ok("png"),
+        "exr" => Ok("exr"),
+        "hdr" => Ok("hdr"),
+        "pfm" => Ok("pfm"),
+        other => Err(format!(
+            "unsupported image format \"{other}\" (acr reads .png, .exr, .hdr and .pfm)"
+        )),
+    }
+}
+
+/// Decodes an image file's bytes in `format` (`png`, `exr`, `hdr` or `pfm`), as
+/// [`read_image`] does.
+pub fn decode_image(data: &[u8], format: &str, srgb: bool) -> Result<RgbImage, String> {
+    let img = match format {
+        "exr" => decode_exr(data)?,
+        "pfm" => parse_pfm(data)?,
+        _ => decode_with_image_crate(data, format)?,
     };
-    Ok(if srgb && extension(path) == "png" {
+    Ok(if srgb && format == "png" {
         linearize(img)
     } else {
         img
@@ -92,9 +113,12 @@ pub fn linearize(mut img: RgbImage) -> RgbImage {
 
 /// PNG and Radiance HDR through the `image` crate: integer samples become [0, 1] floats
 /// (v / 255 or v / 65535), HDR values stay as they are, grey becomes RGB.
-fn read_with_image_crate(path: &Path) -> Result<RgbImage, String> {
-    let img = image::ImageReader::open(path)
-        .map_err(|e| acr_parser::io_message(&e))?
+fn decode_with_image_crate(data: &[u8], format: &str) -> Result<RgbImage, String> {
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(data));
+    if let Some(f) = image::ImageFormat::from_extension(format) {
+        reader.set_format(f);
+    }
+    let img = reader
         .with_guessed_format()
         .map_err(|e| e.to_string())?
         .decode()
@@ -116,28 +140,73 @@ fn read_with_image_crate(path: &Path) -> Result<RgbImage, String> {
 /// fails here instead of sizing an allocation.
 pub const MAX_IMAGE_PIXELS: usize = 1 << 28;
 
-fn read_exr(path: &Path) -> Result<RgbImage, String> {
-    use exr::prelude::*;
-    // The header first: its sizes must be sane before the pixels are allocated.
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| match e {
-        exr::error::Error::Io(io) => acr_parser::io_message(&io),
-        other => other.to_string(),
-    })?;
+/// The most an EXR's raw samples may outweigh its file: deflate (the ZIP compressions) gains
+/// at most about 1032:1, the others less; a header claiming more is corrupt or hostile, and is
+/// refused before its pixels are allocated (a 1 KB file made `acr merge` allocate 1.9 GB).
+const MAX_EXR_RATIO: usize = 1100;
+
+/// An EXR's header, read before its pixels: every layer's size and the display window
+/// (which `acr merge` allocates) must be sane first.
+pub fn exr_header(data: &[u8]) -> Result<exr::meta::MetaData, String> {
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(data), false).map_err(
+        |e| match e {
+            exr::error::Error::Io(io) => acr_parser::io_message(&io),
+            other => other.to_string(),
+        },
+    )?;
     for h in meta.headers.iter() {
+        let display = h.shared_attributes.display_window.size;
         let (w, ht) = (h.layer_size.width(), h.layer_size.height());
-        if w.checked_mul(ht).is_none_or(|n| n > MAX_IMAGE_PIXELS) {
+        for (w, ht) in [(w, ht), (display.width(), display.height())] {
+            if w.checked_mul(ht).is_none_or(|n| n > MAX_IMAGE_PIXELS) {
+                return Err(format!(
+                    "the image is {w}x{ht}, more than {MAX_IMAGE_PIXELS} pixels"
+                ));
+            }
+        }
+        // Its samples at 2 bytes each at least, and one block of them (which the reader
+        // allocates whole), against what the file could hold compressed.
+        let channels = h.channels.list.len().max(1);
+        let raw = w * ht * channels * 2;
+        if raw / MAX_EXR_RATIO > data.len() {
             return Err(format!(
-                "the image is {w}x{ht}, more than {MAX_IMAGE_PIXELS} pixels"
+                "its header claims {w}x{ht} pixels of {channels} channels, more than a file of \
+                 {} bytes can hold",
+                data.len()
+            ));
+        }
+        let block_pixels = match h.blocks {
+            exr::meta::BlockDescription::Tiles(t) => t.tile_size.area(),
+            exr::meta::BlockDescription::ScanLines => {
+                h.compression.scan_lines_per_block().saturating_mul(w)
+            }
+        };
+        let block = block_pixels.saturating_mul(h.channels.bytes_per_pixel);
+        if block / MAX_EXR_RATIO > data.len() {
+            return Err(format!(
+                "its header claims blocks of {block} bytes, more than a file of {} bytes can hold",
+                data.len()
             ));
         }
     }
-    let rgba = read_first_rgba_layer_from_file(
-        path,
-        |size: Vec2<usize>, _: &RgbaChannels| RgbImage::new(size.width(), size.height()),
-        |img: &mut RgbImage, pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
-            img.set(pos.x(), pos.y(), Spectrum::new(r, g, b));
-        },
-    );
+    Ok(meta)
+}
+
+fn decode_exr(data: &[u8]) -> Result<RgbImage, String> {
+    use exr::prelude::*;
+    exr_header(data)?;
+    let rgba = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |size: Vec2<usize>, _: &RgbaChannels| RgbImage::new(size.width(), size.height()),
+            |img: &mut RgbImage, pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
+                img.set(pos.x(), pos.y(), Spectrum::new(r, g, b));
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(data));
     match rgba {
         Ok(image) => Ok(image.layer_data.channel_data.pixels),
         Err(rgb_error) => {
@@ -157,7 +226,7 @@ fn read_exr(path: &Path) -> Result<RgbImage, String> {
                 )
                 .first_valid_layer()
                 .all_attributes()
-                .from_file(path);
+                .from_buffered(std::io::Cursor::new(data));
             match grey {
                 Ok(image) => Ok(image.layer_data.channel_data.pixels),
                 Err(_) => Err(rgb_error.to_string()),
@@ -166,13 +235,8 @@ fn read_exr(path: &Path) -> Result<RgbImage, String> {
     }
 }
 
-/// Reads a PFM file: `PF` (RGB) or `Pf` (grey), width, height and a scale whose sign gives the
+/// Parses a PFM file: `PF` (RGB) or `Pf` (grey), width, height and a scale whose sign gives the
 /// byte order (negative: little-endian), then rows of 32-bit floats from the bottom up.
-fn read_pfm(path: &Path) -> Result<RgbImage, String> {
-    let data = acr_parser::source::read_file(path).map_err(|e| acr_parser::io_message(&e))?;
-    parse_pfm(&data)
-}
-
 fn parse_pfm(data: &[u8]) -> Result<RgbImage, String> {
     // Four whitespace-separated words, then exactly one whitespace byte before the raster.
     let mut pos = 0usize;
@@ -284,15 +348,22 @@ pub fn write_image_in_frame(path: &Path, img: &RgbImage, frame: Frame) -> Result
 /// Reads an EXR and where it lies in its frame (its data window within its display window);
 /// other formats are their own frame.
 pub fn read_image_with_frame(path: &Path) -> Result<(RgbImage, Frame), String> {
-    let img = read_image(path, false)?;
+    let format = image_format(path)?;
+    decode_image_with_frame(&read_image_file(path)?, format)
+}
+
+/// Decodes an image file's bytes in `format` and where it lies in its frame, as
+/// [`read_image_with_frame`] does.
+pub fn decode_image_with_frame(data: &[u8], format: &str) -> Result<(RgbImage, Frame), String> {
+    let img = decode_image(data, format, false)?;
     let mut frame = Frame {
         width: img.width,
         height: img.height,
         x0: 0,
         y0: 0,
     };
-    if is_exr(path) {
-        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+    if format == "exr" {
+        let meta = exr_header(data)?;
         if let Some(h) = meta.headers.first() {
             let display = h.shared_attributes.display_window;
             let pos = h.own_attributes.layer_position;
@@ -451,6 +522,29 @@ mod tests {
             }
         }
         img
+    }
+
+    /// A 1 KB EXR (found by the `merge` fuzz target) whose header claims a 1 GB image: refused
+    /// from its header, before the pixels are allocated.
+    #[test]
+    fn an_exr_claiming_more_than_its_file_can_hold_is_refused_before_allocating() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/merge/huge-claimed-size.exr");
+        let data = std::fs::read(path).unwrap();
+        assert!(data.len() < 10_000);
+        let e = decode_image(&data, "exr", false).unwrap_err();
+        assert!(e.contains("more than a file of"), "{e}");
+    }
+
+    /// A 918-byte EXR (found by the `merge` fuzz target) whose header claims blocks of 2 GB,
+    /// which the EXR reader allocates whole: refused from its header.
+    #[test]
+    fn an_exr_claiming_huge_blocks_is_refused_before_allocating() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/regressions/merge/huge-claimed-block.exr");
+        let data = std::fs::read(path).unwrap();
+        let e = decode_image(&data, "exr", false).unwrap_err();
+        assert!(e.contains("more than a file of"), "{e}");
     }
 
     #[test]

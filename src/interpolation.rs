@@ -82,6 +82,10 @@ pub fn sample_catmull_rom_2d(
         value
     };
     let maximum = interpolate(cdf, size2 - 1);
+    // No positive integral to sample by (pbrt-v3 divides by it regardless).
+    if !(maximum > 0.0 && maximum.is_finite()) {
+        return None;
+    }
     let mut u = u * maximum;
     let idx = find_interval(size2, |i| interpolate(cdf, i) <= u);
     let (f0, f1) = (interpolate(values, idx), interpolate(values, idx + 1));

@@ -199,7 +199,8 @@ pub fn blackbody_rgb(temperature_k: f64, scale: f64) -> Spectrum {
 
 /// Reads a pbrt-v3 `.spd` file: whitespace-separated wavelength/value pairs, `#` comments.
 fn read_spd_file(path: &Path) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
-    let bytes = acr_parser::source::read_file(path).map_err(|e| e.to_string())?;
+    let bytes = acr_parser::source::read_file(path, acr_parser::source::FileKind::Spectrum)
+        .map_err(|e| e.to_string())?;
     let text = String::from_utf8(bytes).map_err(|_| "not a text file".to_owned())?;
     let mut numbers = Vec::new();
     for line in text.lines() {

@@ -173,6 +173,8 @@ fn cropwindow_places_the_crop_and_bad_crops_fail_cleanly() {
 /// SIGTERM (what a scheduler sends before it kills) ends the render at the end of the pass
 /// under way: the image so far is written, the exit status is non-zero with a message. With
 /// `--write-partial-images` the output appears while the render runs (written atomically).
+// Signals, and `libc::kill` to send one, are Unix only.
+#[cfg(unix)]
 #[test]
 fn sigterm_writes_the_image_so_far_and_fails() {
     let dir = temp_dir("signal");
@@ -376,6 +378,8 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
 /// A render stopped by SIGTERM leaves a mergeable EXR of whole passes (its partial writes too:
 /// every pixel as many samples as the header says), and rendering the missing range and
 /// merging gives the render that was never stopped.
+// Signals, and `libc::kill` to send one, are Unix only.
+#[cfg(unix)]
 #[test]
 fn a_stopped_render_resumes_by_rendering_the_rest_and_merging() {
     use acr::cli::mergeable::Sums;

@@ -22,7 +22,7 @@ fn inputs(target: &str) -> Vec<PathBuf> {
 }
 
 /// Runs `check` on each kept input of `target`, naming the input that fails.
-fn replay(target: &str, check: fn(&[u8])) -> usize {
+fn replay(target: &str, check: Check) -> usize {
     let files = inputs(target);
     for f in &files {
         let data = std::fs::read(f).unwrap();
@@ -33,13 +33,38 @@ fn replay(target: &str, check: fn(&[u8])) -> usize {
     files.len()
 }
 
+/// What a target checks on one input (panicking on a bug).
+type Check = fn(&[u8]);
+
+/// Every target and how many inputs its folder keeps. A replay that finds another count
+/// fails: an emptied or deleted folder must not pass as "nothing failed", and a new kept
+/// input is counted here when it is added.
+const KEPT: &[(&str, Check, usize)] = &[
+    ("parse", cases::parse, 0),
+    ("ply", cases::ply, 0),
+    ("scene", cases::scene, 1),
+    ("render", cases::render, 0),
+    ("fourier", cases::fourier, 1),
+    ("merge", cases::merge, 2),
+];
+
 #[test]
 fn kept_fuzz_inputs_pass_their_checks() {
-    let counts = [
-        ("parse", replay("parse", cases::parse)),
-        ("ply", replay("ply", cases::ply)),
-        ("scene", replay("scene", cases::scene)),
-        ("render", replay("render", cases::render)),
-    ];
-    eprintln!("replayed {counts:?}");
+    for &(target, check, kept) in KEPT {
+        let n = replay(target, check);
+        assert_eq!(
+            n, kept,
+            "fuzz/regressions/{target}/ holds {n} inputs, {kept} were kept"
+        );
+    }
+    // Every target's folder is listed above (a new target's crashes are replayed too).
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
+    let mut folders: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    folders.sort();
+    let mut listed: Vec<String> = KEPT.iter().map(|k| k.0.to_owned()).collect();
+    listed.sort();
+    assert_eq!(folders, listed);
 }

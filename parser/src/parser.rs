@@ -81,7 +81,8 @@ fn parse_source(file: Arc<SourceFile>) -> Result<SceneDescription> {
 
 /// Reads a scene file, mapping I/O and encoding errors to a clear message.
 fn read_text(path: &Path) -> Result<String> {
-    let bytes = crate::source::read_file(path).map_err(|e| Error::file(path, io_message(&e)))?;
+    let bytes = crate::source::read_file(path, crate::source::FileKind::Scene)
+        .map_err(|e| Error::file(path, io_message(&e)))?;
     decode_text(path, bytes)
 }
 
@@ -333,12 +334,13 @@ impl Parser {
             ));
         }
         let path = resolve_path(name, self.file(), &self.base_dir);
-        let bytes = crate::source::read_file(&path).map_err(|e| {
-            Error::at(
-                loc,
-                format!("cannot read included file \"{name}\": {}", io_message(&e)),
-            )
-        })?;
+        let bytes =
+            crate::source::read_file(&path, crate::source::FileKind::Scene).map_err(|e| {
+                Error::at(
+                    loc,
+                    format!("cannot read included file \"{name}\": {}", io_message(&e)),
+                )
+            })?;
         let text = decode_text(&path, bytes)?;
         let file = SourceFile::new(path, text);
         self.builder.add_file(Arc::clone(&file));

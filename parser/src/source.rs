@@ -166,21 +166,102 @@ impl fmt::Debug for Loc {
     }
 }
 
-/// Reads a whole file named in a scene, refusing devices and sockets (`/dev/zero` would never
-/// end) with an `InvalidInput` error before reading anything.
-pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        let t = std::fs::metadata(path)?.file_type();
-        if t.is_char_device() || t.is_block_device() || t.is_socket() {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "not a regular file but a device or socket",
-            ));
+/// What a file named in a scene holds, which bounds the size it may have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// A scene file, the main one or an `Include`d one.
+    Scene,
+    /// A `plymesh` file.
+    Ply,
+    /// An image: a texture, an image light's map, an `acr merge` or `acr diff` input.
+    Image,
+    /// A `fourier` material's `bsdffile` table.
+    BsdfTable,
+    /// A spectrum (`.spd`) file.
+    Spectrum,
+}
+
+impl FileKind {
+    /// The most bytes a file of this kind may have: far above any real one, so that only a
+    /// wrong or hostile name (a disk image, a log that grows) is refused before it fills memory.
+    pub const fn max_bytes(self) -> u64 {
+        match self {
+            // Locations are 32-bit byte offsets.
+            FileKind::Scene => u32::MAX as u64,
+            FileKind::Ply => 16 << 30,
+            // 16384 x 16384 RGBA float pixels (the most an image may have) and headers.
+            FileKind::Image => 5 << 30,
+            // pbrt-v3's tables are a few MB; layerlab's largest some hundred.
+            FileKind::BsdfTable => 1 << 30,
+            FileKind::Spectrum => 16 << 20,
         }
     }
-    std::fs::read(path)
+
+    /// The kind in words, for messages.
+    pub const fn name(self) -> &'static str {
+        match self {
+            FileKind::Scene => "scene file",
+            FileKind::Ply => "PLY file",
+            FileKind::Image => "image",
+            FileKind::BsdfTable => "BSDF table",
+            FileKind::Spectrum => "spectrum file",
+        }
+    }
+}
+
+/// Opens a file named in a scene (every such file is opened here, most through
+/// [`read_file`]): a regular file, at most [`FileKind::max_bytes`] long. Folders, devices
+/// (`/dev/zero` would never end), pipes (whose opening waits for a writer) and sockets are
+/// refused before opening, and so is a file too long. Errors are `InvalidInput` with a message
+/// that says which check failed; the caller adds where the file was named. Gives the file and
+/// its length.
+pub fn open_file(path: &Path, kind: FileKind) -> std::io::Result<(std::fs::File, u64)> {
+    let check = |meta: &std::fs::Metadata| {
+        if meta.is_dir() {
+            Err(refused("a folder, not a file".to_owned()))
+        } else if !meta.is_file() {
+            Err(refused(
+                "not a regular file but a device, pipe or socket".to_owned(),
+            ))
+        } else if meta.len() > kind.max_bytes() {
+            Err(too_long(meta.len(), kind))
+        } else {
+            Ok(meta.len())
+        }
+    };
+    check(&std::fs::metadata(path)?)?;
+    let file = std::fs::File::open(path)?;
+    // Again on what was opened, in case the name changed meanwhile.
+    let len = check(&file.metadata()?)?;
+    Ok((file, len))
+}
+
+/// Reads a whole file named in a scene, checked as [`open_file`] checks it; the read is
+/// bounded again in case the file grows meanwhile.
+pub fn read_file(path: &Path, kind: FileKind) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let (file, len) = open_file(path, kind)?;
+    let limit = kind.max_bytes();
+    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_long(bytes.len() as u64, kind));
+    }
+    Ok(bytes)
+}
+
+/// A refusal by [`open_file`], with its reason.
+fn refused(message: String) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidInput, message)
+}
+
+/// The refusal of a file of `n` bytes, longer than a `kind` may be.
+fn too_long(n: u64, kind: FileKind) -> std::io::Error {
+    refused(format!(
+        "{n} bytes, more than a {} may have ({})",
+        kind.name(),
+        kind.max_bytes()
+    ))
 }
 
 #[cfg(test)]
@@ -197,6 +278,53 @@ mod tests {
             .map_or(0, |p| p + 1);
         let col = String::from_utf8_lossy(&before[start..]).chars().count() + 1;
         (line, col)
+    }
+
+    /// A fresh empty folder under the system's temporary folder.
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("acr-source-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn read_file_reads_a_regular_file_and_refuses_folders_and_long_files_before_reading() {
+        let dir = temp_dir("read");
+        let small = dir.join("small.spd");
+        std::fs::write(&small, "400 1\n").unwrap();
+        assert_eq!(read_file(&small, FileKind::Spectrum).unwrap(), b"400 1\n");
+
+        let e = read_file(&dir, FileKind::Scene).unwrap_err();
+        assert!(e.to_string().contains("a folder, not a file"), "{e}");
+
+        // A sparse file one byte over the limit: refused from its size, nothing read.
+        let long = dir.join("long.spd");
+        let f = std::fs::File::create(&long).unwrap();
+        f.set_len(FileKind::Spectrum.max_bytes() + 1).unwrap();
+        let e = read_file(&long, FileKind::Spectrum).unwrap_err();
+        assert!(
+            e.to_string().contains("more than a spectrum file may have"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn read_file_refuses_devices_and_pipes_without_reading_or_waiting() {
+        for kind in [FileKind::Scene, FileKind::BsdfTable, FileKind::Image] {
+            let e = read_file(Path::new("/dev/zero"), kind).unwrap_err();
+            assert!(e.to_string().contains("device, pipe or socket"), "{e}");
+        }
+        let dir = temp_dir("fifo");
+        let fifo = dir.join("pipe.pbrt");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo failed");
+        // Opening the pipe would wait for a writer forever.
+        let e = read_file(&fifo, FileKind::Scene).unwrap_err();
+        assert!(e.to_string().contains("device, pipe or socket"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

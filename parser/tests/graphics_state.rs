@@ -334,6 +334,33 @@ fn error_shows_line_and_caret() {
     );
 }
 
+/// Parses `text` and asserts that it gives a description or an error at a place in it: the
+/// error names `t.pbrt`, a line the text has and a column from 1, in that order at its start.
+/// Gives whether it was an error.
+fn ok_or_located_error(text: &str) -> bool {
+    match parse_str(text, Path::new("t.pbrt")) {
+        Ok(_) => false,
+        Err(e @ acr_parser::Error::At { .. }) => {
+            let acr_parser::Error::At { loc, .. } = &e else {
+                unreachable!()
+            };
+            let (line, col) = loc.line_col();
+            let lines = text.split('\n').count();
+            assert!(
+                (1..=lines).contains(&line) && col >= 1,
+                "{text:?}: {line}:{col} is not in the text: {e}"
+            );
+            let shown = e.to_string();
+            assert!(
+                shown.starts_with(&format!("t.pbrt:{line}:{col}: ")),
+                "{text:?}: {shown}"
+            );
+            true
+        }
+        Err(e) => panic!("{text:?}: an error with no place in the text: {e}"),
+    }
+}
+
 #[test]
 fn garbage_never_panics() {
     // Every prefix of a realistic scene, and some noise, gives Ok or a located error.
@@ -341,8 +368,10 @@ fn garbage_never_panics() {
                  WorldBegin AttributeBegin Material \"matte\" \"rgb Kd\" [.5 .5 .5]\n\
                  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n\
                  AttributeEnd WorldEnd\n";
+    assert!(!ok_or_located_error(scene), "the whole scene parses");
+    let mut errors = 0;
     for end in 0..=scene.len() {
-        let _ = parse_str(&scene[..end], Path::new("t.pbrt"));
+        errors += usize::from(ok_or_located_error(&scene[..end]));
     }
     for noise in [
         "\u{0}\u{1}",
@@ -355,6 +384,8 @@ fn garbage_never_panics() {
         "\u{feff}WorldBegin",
         "é",
     ] {
-        let _ = parse_str(noise, Path::new("t.pbrt"));
+        errors += usize::from(ok_or_located_error(noise));
     }
+    // Most prefixes end inside a directive: the check above ran on their errors.
+    assert!(errors > scene.len() / 2, "only {errors} errors");
 }

@@ -473,11 +473,31 @@ fn box_filter_converges_on_edge() {
 
 /// With the box filter and independent points a pixel is the mean of N uniform samples of f
 /// over it, so the RMS error is exactly sqrt(mean over pixels of Var_pixel(f) / N): the
-/// measured errors must match that (up to the noise of 8 seeds' estimate, about 2%). The
-/// window is wide on the low side because the random sampler's points are correlated
-/// (`random_sampler_points_are_independent`): at 64 and 256 spp the smooth image's error is
-/// 12% below the prediction.
+/// measured errors must match that up to the noise of the 8 seeds' estimate. That noise was
+/// measured over 30 other sets of 8 seeds (first seeds 5000, 5100, ..., 7900): the ratio's
+/// standard deviation is 1.3-1.6% on the smooth image (means 0.998-1.001) and 4.1-5.8% on the
+/// edge (means 0.979-0.997; only the pixels the edge crosses have any variance). The window
+/// is 4 of those deviations, the larger over spp, each side of 1.
 fn check_random_box(random: &Convergence, g: Integrand) {
+    let sigma = match g {
+        Integrand::Smooth => 0.016,
+        Integrand::Edge => 0.058,
+    };
+    let window = 1.0 - 4.0 * sigma..1.0 + 4.0 * sigma;
+    for ((e, &n), predicted) in random.errors.iter().zip(&SPPS).zip(random_box_rms(g)) {
+        eprintln!("    random box {g:?} spp {n}: RMS {e:.3e}, predicted {predicted:.3e}");
+        let ratio = e / predicted;
+        assert!(
+            window.contains(&ratio),
+            "random box {g:?} spp {n}: RMS {e} vs predicted {predicted} (ratio {ratio}, \
+             window {window:?})"
+        );
+    }
+}
+
+/// The RMS error of the box filter with independent points on `g` at each spp of SPPS:
+/// sqrt(mean over pixels of Var_pixel(f) / N).
+fn random_box_rms(g: Integrand) -> Vec<f64> {
     let mut var = 0.0;
     for k in 0..W * H {
         let (i, j) = (f64::from(k % W), f64::from(k / W));
@@ -502,15 +522,7 @@ fn check_random_box(random: &Convergence, g: Integrand) {
         };
     }
     var /= f64::from(W * H);
-    for (e, &n) in random.errors.iter().zip(&SPPS) {
-        let predicted = (var / f64::from(n)).sqrt();
-        eprintln!("    random box {g:?} spp {n}: RMS {e:.3e}, predicted {predicted:.3e}");
-        let ratio = e / predicted;
-        assert!(
-            (0.8..1.25).contains(&ratio),
-            "random box {g:?} spp {n}: RMS {e} vs predicted {predicted}"
-        );
-    }
+    SPPS.iter().map(|&n| (var / f64::from(n)).sqrt()).collect()
 }
 
 #[test]

@@ -168,10 +168,11 @@ fn registry_samplers_stratify_the_rendering_space() {
 }
 
 /// The random sampler promises independent points: the variance of a pixel's mean of each
-/// coordinate must then be 1 / (12 spp). It is 20-35% lower in x, y, t and u (the points of a
-/// pixel are correlated: sample k is the first output of `Pcg32::new(key, k)`, PCG streams of
-/// one seed whose states start on an arithmetic progression), and for some frequencies the
-/// error is instead up to ~1.8 times that of independent points.
+/// coordinate must then be 1 / (12 spp). Over 4096 pixels the measured ratio's own noise is
+/// sqrt(2 / 4096) = 2.2% for independent points; measured over 40 other seeds (100 to 139):
+/// standard deviation 1.8-2.4% per coordinate, means 0.9995-1.0066. The window is 4 of those
+/// deviations (0.024) each side of 1. (Correlated points, as the sampler once gave, put x, y,
+/// t and u 20-35% low.)
 #[test]
 fn random_sampler_points_are_independent() {
     let all = Dims {
@@ -193,9 +194,9 @@ fn random_sampler_points_are_independent() {
         })
         .collect();
     eprintln!("random: variance of the pixel mean over 1 / (12 spp), x y t u v: {ratios:.3?}");
-    // 4096 pixels: each ratio is 1 within about 2% if the points are independent.
+    let window = 1.0 - 4.0 * 0.024..1.0 + 4.0 * 0.024;
     assert!(
-        ratios.iter().all(|r| (0.85..1.15).contains(r)),
-        "{ratios:?}"
+        ratios.iter().all(|r| window.contains(r)),
+        "{ratios:?} not all in {window:?}"
     );
 }

@@ -204,7 +204,11 @@ impl Sums {
 
     /// Reads a mergeable EXR; `None` when the file lacks the sums (a plain image).
     pub fn read(path: &Path) -> std::result::Result<Option<Sums>, String> {
-        let layer = Channels::read(path)?;
+        Ok(Self::from_channels(Channels::read(path)?))
+    }
+
+    /// The sums a mergeable EXR's first layer holds; `None` when it lacks them.
+    pub fn from_channels(layer: Channels) -> Option<Sums> {
         let find = |name: &str| {
             layer
                 .get(name)
@@ -217,7 +221,7 @@ impl Sums {
             find("weight"),
             find("count"),
         ) else {
-            return Ok(None);
+            return None;
         };
         let moment_channels = ["moment1.R", "moment1.G", "moment1.B"]
             .into_iter()
@@ -243,7 +247,7 @@ impl Sums {
             .filter(|(name, _)| !OWN_CHANNELS.contains(&name.as_str()))
             .cloned()
             .collect();
-        Ok(Some(Sums {
+        Some(Sums {
             frame: layer.frame,
             width: layer.width,
             height: layer.height,
@@ -258,6 +262,6 @@ impl Sums {
                 _ => None,
             },
             seconds,
-        }))
+        })
     }
 }

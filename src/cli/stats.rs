@@ -76,6 +76,9 @@ pub struct Stats {
     /// With `--sampler-cost`: the share of the render's wall time the sampler added, the
     /// median over three back-to-back pairs of (rerender - replay) / rerender (0 if negative).
     pub sampler_share: Option<f64>,
+    /// With `--sampler-cost`: each back-to-back pair's [rerender, replay] seconds, in the
+    /// order run (`seconds.rerender`, `seconds.replay` and `sampler_share` are their medians).
+    pub sampler_cost_pairs: Option<[[f64; 2]; 3]>,
     /// Millions of rays per second of render time.
     pub mrays_per_s: f64,
     /// Peak resident memory in MiB.

@@ -47,8 +47,14 @@ impl FourierTable {
         if let Some(t) = tables.get(path) {
             return Ok(t);
         }
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        let bytes = acr_parser::source::read_file(path, acr_parser::source::FileKind::BsdfTable)
+            .map_err(|e| {
+                format!(
+                    "cannot read {}: {}",
+                    path.display(),
+                    acr_parser::io_message(&e)
+                )
+            })?;
         let table: &'static FourierTable = Box::leak(Box::new(
             Self::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?,
         ));
@@ -270,14 +276,19 @@ impl FourierBsdf {
         let pdf = (pdf_phi * pdf_mu).max(0.0);
         let sin2_theta_i = (1.0 - mu_i * mu_i).max(0.0);
         let sin2_theta_o = (1.0 - wo.z * wo.z).max(0.0);
-        let mut norm = (sin2_theta_i / sin2_theta_o).sqrt();
-        if norm.is_infinite() {
-            norm = 0.0;
-        }
+        // The azimuth is measured from wo's; along the normal wo has none, and pbrt-v3's
+        // sqrt(sin2_theta_i / 0), taken as 0 (or NaN when both are 0), put wi on the normal
+        // whatever mu_i was sampled: measured from the x axis there instead.
+        let (wo_x, wo_y, norm) = if sin2_theta_o > 0.0 {
+            let norm = (sin2_theta_i / sin2_theta_o).sqrt();
+            (wo.x, wo.y, if norm.is_infinite() { 0.0 } else { norm })
+        } else {
+            (1.0, 0.0, sin2_theta_i.sqrt())
+        };
         let (sin_phi, cos_phi) = phi.sin_cos();
         let wi = -Vec3::new(
-            norm * (cos_phi * wo.x - sin_phi * wo.y),
-            norm * (sin_phi * wo.x + cos_phi * wo.y),
+            norm * (cos_phi * wo_x - sin_phi * wo_y),
+            norm * (sin_phi * wo_x + cos_phi * wo_y),
             mu_i,
         );
         // pbrt-v3 normalises again: rounding would otherwise grow over bounces.

@@ -142,3 +142,21 @@ fn a_missing_bsdf_file_is_a_located_error() {
             .to_string();
     assert!(e.contains("needs \"string bsdffile\""), "{e}");
 }
+
+/// Along the normal wo has no azimuth: the sampled wi keeps its sampled zenith (pbrt-v3's
+/// formula put every such wi on the normal) and agrees with evaluation there.
+#[test]
+fn sampling_at_normal_incidence_agrees_with_evaluation() {
+    let b = bsdf();
+    let wo = Vec3::new(0.0, 0.0, 1.0);
+    for u in [[0.1, 0.2], [0.5, 0.5], [0.9, 0.7], [0.3, 0.95]] {
+        let (wi, f, pdf) = b.sample_f(wo, u).expect("a sample");
+        assert!((wi.length() - 1.0).abs() < 1e-5, "{u:?}: {wi}");
+        assert!(wi.z.abs() < 0.9999, "{u:?}: {wi} lies on the normal");
+        let (f2, pdf2) = (b.f(wo, wi), b.pdf(wo, wi));
+        assert!(close(pdf, pdf2, 2e-3), "{u:?}: pdf {pdf} vs {pdf2}");
+        for c in 0..3 {
+            assert!(close(f[c], f2[c], 2e-3), "{u:?}: f {f} vs {f2}");
+        }
+    }
+}

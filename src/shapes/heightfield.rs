@@ -16,7 +16,7 @@ pub fn mesh_from_params(params: &ParamList, loc: &Loc) -> Result<Mesh> {
     };
     let nu = i64::from(params.int_or("nu", -1)?);
     let nv = i64::from(params.int_or("nv", -1)?);
-    if nu < 2 || nv < 2 || nu * nv > MAX_VERTICES {
+    if nu < 2 || nv < 2 {
         let name = if nu < 2 { "nu" } else { "nv" };
         return Err(Error::at(
             &at(name),
@@ -28,12 +28,23 @@ pub fn mesh_from_params(params: &ParamList, loc: &Loc) -> Result<Mesh> {
     let Some(z) = params.floats("Pz")? else {
         return Err(Error::at(loc, "heightfield needs a \"float Pz\" parameter"));
     };
+    // One height per vertex: a count that differs is the usual mistake, whatever nu and nv.
     if z.len() as i64 != nu * nv {
         return Err(Error::at(
             &at("Pz"),
             format!(
-                "heightfield: {} values in Pz for nu x nv = {}",
+                "heightfield: Pz has {} values, but nu x nv = {nu} x {nv} = {} (one height per \
+                 vertex)",
                 z.len(),
+                nu * nv
+            ),
+        ));
+    }
+    if nu * nv > MAX_VERTICES {
+        return Err(Error::at(
+            &at("nu"),
+            format!(
+                "heightfield: nu x nv = {nu} x {nv} = {} vertices, more than {MAX_VERTICES}",
                 nu * nv
             ),
         ));
@@ -99,7 +110,12 @@ mod tests {
             (r#"Shape "heightfield" "integer nu" 2 "integer nv" 2"#, "Pz"),
             (
                 r#"Shape "heightfield" "integer nu" 2 "integer nv" 2 "float Pz" [0 1 2]"#,
-                "3 values",
+                "Pz has 3 values, but nu x nv = 2 x 2 = 4",
+            ),
+            // Large counts with too few heights: the heights are the cause, not nu or nv.
+            (
+                r#"Shape "heightfield" "integer nu" 100000 "integer nv" 100000 "float Pz" [0 1 2]"#,
+                "Pz has 3 values, but nu x nv = 100000 x 100000 = 10000000000",
             ),
         ] {
             let (p, loc) = shape_params(text);

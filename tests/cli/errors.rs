@@ -159,6 +159,60 @@ fn every_bad_input_fails_cleanly_with_its_location() {
     }
 }
 
+/// Every kind of file a scene names, named as a device: refused at once with a located error
+/// that says why, without reading (the `fourier` material's table once read `/dev/zero`
+/// until the machine ran out of memory; the memory and time guard of [`output_within`]
+/// stops such a run within a second or two).
+#[cfg(unix)]
+#[test]
+fn a_device_named_as_any_scene_file_is_refused_at_once() {
+    let dir = TempDir::new("devices");
+    let out = dir.join("out.png");
+    // Images are read by their extension: a device under an image's name.
+    for name in ["zero.png", "zero.exr"] {
+        std::os::unix::fs::symlink("/dev/zero", dir.join(name)).unwrap();
+    }
+    let world = "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\" Film \"image\" \
+                 \"integer xresolution\" 8 \"integer yresolution\" 8\nWorldBegin\n";
+    for (what, line) in [
+        ("Include", "Include \"/dev/zero\""),
+        ("PLY", "Shape \"plymesh\" \"string filename\" \"/dev/zero\""),
+        (
+            "image texture",
+            "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"zero.png\"\n\
+             Material \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"",
+        ),
+        (
+            "image light",
+            "LightSource \"infinite\" \"string mapname\" \"zero.exr\"",
+        ),
+        (
+            "fourier table",
+            "Material \"fourier\" \"string bsdffile\" \"/dev/zero\"\nShape \"sphere\"",
+        ),
+        (
+            "spectrum file",
+            "Material \"matte\" \"spectrum Kd\" \"/dev/zero\"\nShape \"sphere\"",
+        ),
+    ] {
+        let scene = dir.write("d.pbrt", &format!("{world}{line}\nWorldEnd\n"));
+        let started = Instant::now();
+        let o = output_within(
+            acr_command(render_args(&scene, &out)),
+            Duration::from_secs(20),
+        );
+        assert_clean_failure(&o, what);
+        let err = stderr(&o);
+        assert!(
+            err.starts_with(&format!("{}:4:", scene.display())),
+            "{what}: not located: {err}"
+        );
+        assert!(err.contains("device, pipe or socket"), "{what}: {err}");
+        // Refused before reading: as fast as any error (a build of this tiny scene).
+        assert!(started.elapsed() < Duration::from_secs(10), "{what}");
+    }
+}
+
 #[test]
 fn unknown_plugins_and_parameters_are_located_errors_with_the_closest_name() {
     let dir = TempDir::new("badplugins");

@@ -164,7 +164,20 @@ fn render_fails(scene: &Path, output: &Path, args: &[&str], message: &str) {
     assert!(stderr(&o).contains(message), "{}", stderr(&o));
 }
 
-/// Runs `cmd` and kills it if it has not finished within `limit`.
+/// Most memory a command run by [`output_within`] may hold: far above what the small scenes
+/// the tests give need, and low enough that an unbounded read is stopped in a second or two
+/// before it takes the machine.
+const MEMORY_LIMIT_KB: u64 = 2 << 20;
+
+/// The resident memory of process `pid` in kB, where the system tells it (Linux).
+fn resident_kb(pid: u32) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// Runs `cmd` and kills it if it has not finished within `limit`, or (on Linux) once it
+/// holds more than [`MEMORY_LIMIT_KB`].
 fn output_within(mut cmd: Command, limit: Duration) -> Output {
     let mut child = cmd
         .stdout(Stdio::piped())
@@ -173,10 +186,16 @@ fn output_within(mut cmd: Command, limit: Duration) -> Output {
         .unwrap();
     let start = Instant::now();
     while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
+        let rss = resident_kb(child.id()).unwrap_or(0);
+        if start.elapsed() > limit || rss > MEMORY_LIMIT_KB {
             let _ = child.kill();
             let o = child.wait_with_output().unwrap();
-            panic!("still running after {limit:?} (rendering?): {}", stderr(&o));
+            panic!(
+                "still running after {:?} (limit {limit:?}), holding {rss} kB (limit \
+                 {MEMORY_LIMIT_KB}): {}",
+                start.elapsed(),
+                stderr(&o)
+            );
         }
         std::thread::sleep(Duration::from_millis(20));
     }

@@ -2,6 +2,39 @@
 
 use super::*;
 
+/// The image's estimated relative error as `--noise-threshold` measures it
+/// (`acr::render::relative_error`: the mean over pixels of the standard error of the pixel's
+/// mean luminance over that mean + 0.01, 1 for pixels of fewer than 2 samples), recomputed
+/// from the per-pixel sample moments of the mergeable EXR at `path`.
+fn relative_error_of_mergeable(path: &Path) -> f64 {
+    use acr::geometry::Spectrum;
+    let s = acr::cli::mergeable::Sums::read(path)
+        .unwrap()
+        .expect("a mergeable EXR");
+    let moments = s.moments.as_ref().expect("sample moments");
+    let luminance = |f: &dyn Fn(usize) -> f64| {
+        f64::from(acr::spectrum_luminance(Spectrum::new(
+            f(0) as f32,
+            f(1) as f32,
+            f(2) as f32,
+        )))
+    };
+    let total: f64 = moments
+        .iter()
+        .zip(&s.counts)
+        .map(|(m, &n)| {
+            if n < 2.0 {
+                return 1.0;
+            }
+            let mean = luminance(&|c| m[c] / n);
+            let variance_of_mean =
+                luminance(&|c| (m[3 + c] - m[c] * m[c] / n).max(0.0) / (n - 1.0) / n);
+            acr_plugins::film::relative_error_of(mean, variance_of_mean)
+        })
+        .sum();
+    total / moments.len() as f64
+}
+
 /// `--noise-threshold`: a loose threshold stops at `--min-spp` (plus the pass under way), with
 /// every pixel at the same count, for every kind of sampler; a tighter one takes more samples
 /// and ends with a lower error; the cluster sampler adapts before it stops; one that is never
@@ -30,13 +63,26 @@ fn a_noise_threshold_stops_early_keeps_min_spp_and_spp_caps_it() {
         assert_eq!(s["halted"], true, "{sampler}");
         assert_eq!(s["halted_by"], "noise", "{sampler}");
     }
-    // Tighter thresholds: more samples, and the error they stop at is below the threshold.
-    let spp_at = |t: &str| {
-        let s = run("stratified", &["--spp", "1024", "--noise-threshold", t]);
-        s["samples"].as_u64().unwrap() / pixels
+    // Tighter thresholds: more samples, and the error they stop at is below the threshold
+    // (recomputed from the image's sample moments, which a mergeable EXR holds).
+    let stop_at = |t: &str| {
+        let (out, stats) = (dir.join(format!("t{t}.exr")), dir.join("t.json"));
+        let args = ["--sampler", "stratified", "--seed", "1", "--spp", "1024"];
+        let more = ["--noise-threshold", t, "--mergeable", "--stats"];
+        let all = [&args[..], &more[..], &[stats.to_str().unwrap()]].concat();
+        render_ok(&scene, &out, &all);
+        let spp = read_stats(&stats)["samples"].as_u64().unwrap() / pixels;
+        (spp, relative_error_of_mergeable(&out))
     };
-    let (loose, tight) = (spp_at("0.3"), spp_at("0.1"));
+    let ((loose, loose_error), (tight, tight_error)) = (stop_at("0.3"), stop_at("0.1"));
+    eprintln!("stopped at {loose} spp, error {loose_error}; at {tight} spp, error {tight_error}");
     assert!(loose < tight && tight < 1024, "{loose} then {tight} spp");
+    assert!(
+        loose_error <= 0.3 && tight_error <= 0.1,
+        "errors at the stop: {loose_error} (threshold 0.3), {tight_error} (0.1)"
+    );
+    // The loose one stopped early: its error is still above the tight threshold.
+    assert!(loose_error > 0.1, "loose error {loose_error}");
     // The cluster sampler adapts toward the threshold: its first stage is --min-spp (not a
     // quarter of --spp), and it has planned rounds by the time the threshold stops it.
     let s = run(

@@ -356,7 +356,7 @@ impl Builder {
         if let Some(mesh) = self.ply_cache.get(&path) {
             return Ok(Arc::clone(mesh));
         }
-        let bytes = crate::source::read_file(&path).map_err(|e| {
+        let bytes = crate::source::read_file(&path, crate::source::FileKind::Ply).map_err(|e| {
             Error::at(
                 &loc,
                 format!("cannot read PLY file \"{name}\": {}", io_message(&e)),

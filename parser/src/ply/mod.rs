@@ -36,7 +36,8 @@ pub struct Ply {
 
 /// Reads a PLY file from disk.
 pub fn read_ply(path: &Path) -> Result<Ply, String> {
-    let bytes = crate::source::read_file(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    let bytes = crate::source::read_file(path, crate::source::FileKind::Ply)
+        .map_err(|e| format!("cannot read the file: {e}"))?;
     parse_ply(&bytes)
 }
 

@@ -641,26 +641,6 @@ pub(crate) mod tests {
         assert!((star_discrepancy(&c) - 1.0 / 16.0).abs() < 1e-12);
     }
 
-    /// Generation speed, one sampler at a time (`cargo test -p acr-plugins --release --
-    /// --ignored --nocapture throughput`): the render loop generates batches sequentially.
-    #[test]
-    #[ignore]
-    fn throughput() {
-        for dims in [ALL_DIMS[0], ALL_DIMS[3]] {
-            let sp = space(0, 0, 512, 512, dims);
-            for mut s in all(sp, 16, 1) {
-                let mut b = Vec::new();
-                let t = std::time::Instant::now();
-                let mut n = 0;
-                while s.next_batch(&mut b) {
-                    n += b.len();
-                }
-                let ns = t.elapsed().as_nanos() as f64 / n as f64;
-                eprintln!("{:>10} dims {:?}: {ns:.1} ns/point", s.name(), dims.names());
-            }
-        }
-    }
-
     #[test]
     fn pixels_differ() {
         // Neighbouring pixels do not repeat each other's offsets (per-pixel scrambling).

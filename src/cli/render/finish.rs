@@ -111,6 +111,7 @@ pub(super) fn stats(
             0.0
         },
         sampler_share: cost.map(|c| c.share),
+        sampler_cost_pairs: cost.map(|c| c.pairs),
         peak_rss_mb: peak_rss_mb(),
     }
 }

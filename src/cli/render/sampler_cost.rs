@@ -23,6 +23,8 @@ pub(super) struct SamplerCost {
     /// The median over pairs of (render - replay) / render, each pair run back to back: the
     /// machine's drift cancels within a pair.
     pub(super) share: f64,
+    /// Each pair's [render, replay], in the order run.
+    pub(super) pairs: [[f64; 2]; SamplerCostRun::PAIRS],
 }
 
 /// What `--sampler-cost` needs to render the scene again, and the first render's film.
@@ -78,7 +80,9 @@ impl SamplerCostRun<'_> {
             .zip(&replays)
             .map(|(r, p)| (r - p) / r.max(1e-9))
             .collect();
+        let pairs = std::array::from_fn(|i| [renders[i], replays[i]]);
         Ok(SamplerCost {
+            pairs,
             render: median(&mut renders),
             replay: median(&mut replays),
             share: median(&mut shares).max(0.0),
