@@ -1,4 +1,4 @@
-//! The feature vector F = (g, s, p) of a cell (ALGORITHM.md section 3, paper eq. 2-9).
+//! The feature vector F = (g, s, p) of a cell (docs/algorithm.md §3, paper eq. 2-9).
 
 use super::grid::{CellGrid, Coords, MAX_DIMS};
 use super::sums::CellSums;

@@ -1,4 +1,4 @@
-//! The clustering of the rendering space (ALGORITHM.md sections 2 to 4): the cell grid and its
+//! The clustering of the rendering space (docs/algorithm.md §2 to §4): the cell grid and its
 //! running sums, the feature vector of each cell, and clusters of cells. The cluster sampler
 //! drives it; a reconstruction that needs clusters builds them with the same code.
 
