@@ -1,5 +1,5 @@
-//! Criterion micro-benchmarks of the hot paths (issue 5): BVH traversal on a 1M-triangle mesh
-//! (coherent camera rays and scattered rays; closest hit and shadow query; 1 and 2 threads),
+//! Criterion micro-benchmarks of the hot paths (docs/BENCHMARKS.md): BVH traversal on a 1M-triangle
+//! mesh (coherent camera rays and scattered rays; closest hit and shadow query; 1 and 2 threads),
 //! one full round of every sampler, and the film's splatting and reconstruction.
 //! Run with `cargo bench --bench hot_paths`; throughputs print as elements/s (rays, samples or
 //! pixels per second).

@@ -1,5 +1,5 @@
-//! Criterion benchmark of `acr parse` on a generated large scene (issue 27): parsing, and the
-//! scene-graph dump, which prints a location per directive and parameter. Run with
+//! Criterion benchmark of `acr parse` on a generated large scene (docs/BENCHMARKS.md): parsing, and
+//! the scene-graph dump, which prints a location per directive and parameter. Run with
 //! `cargo bench --bench parse`; throughput prints as bytes/s of scene text.
 
 use acr::parser::parse_str;
@@ -7,8 +7,8 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use std::path::Path;
 
-/// Shapes in the generated scene: about 1.9 MB of text (a tenth of the 19 MB scene the README
-/// times `acr parse` on).
+/// Shapes in the generated scene: about 1.9 MB of text (a tenth of the 19 MB scene that
+/// docs/pbrt-v3-compatibility.md times `acr parse` on).
 const SHAPES: u64 = 4000;
 
 /// A scene of `SHAPES` small triangle meshes, each in its own attribute block with a material

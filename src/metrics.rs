@@ -1,4 +1,4 @@
-//! Image error metrics (ALGORITHM.md section 7): MSE and relMSE on linear radiance, PSNR on the
+//! Image error metrics (docs/algorithm.md §7): MSE and relMSE on linear radiance, PSNR on the
 //! image clamped to [0, 1].
 
 use crate::image_io::RgbImage;

@@ -161,7 +161,7 @@ mod tests {
     fn noise_fbm_and_turbulence_match_pbrt_v3() {
         // Printed by pbrt-v3 itself: Noise, FBm and Turbulence (omega 0.5, 8 octaves, zero
         // differentials) at these points, from a program linked with pbrt-v3's libpbrt
-        // (core/texture.h's functions; the README's "Procedural textures" says how).
+        // (core/texture.h's functions; tests/data/pbrt-v3/noisecheck.cpp).
         let cases = [
             ([0.5, 0.5, 0.5], [-0.125, -0.118037626, 0.188432008]),
             ([1.3, 2.7, 0.4], [0.571163952, 0.890168071, 0.891302645]),

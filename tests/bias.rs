@@ -1,5 +1,5 @@
-//! The adaptive samplers' shift of the image mean on a room lit only indirectly (issue 26,
-//! item 3): as published (each pixel's count decided from its own samples) the cluster
+//! The adaptive samplers' shift of the image mean on a room lit only indirectly (docs/algorithm.md
+//! §8, docs/rivals.md): as published (each pixel's count decided from its own samples) the cluster
 //! sampler and awr render it dark; unbiased (each pixel's count decided from the other colour
 //! of a checkerboard, the cluster sampler's default), with a pilot stream, or with two streams
 //! (each placed by the other's values), the mean comes back within 1% of a stratified
@@ -53,7 +53,7 @@ fn the_dark_shift_comes_off_the_indirectly_lit_room() {
         let published = ["sampler.unbiased=false"];
         let one = room_mean(sampler, "gaussian", &published, 4, 1) / reference;
         println!("{sampler} as published: {one:.4} of stratified's mean");
-        // Measured (README, "The image mean"): -3.0% (cluster) and -4.6% (awr) against the
+        // Measured (docs/rivals.md, "Selection bias"): -3.0% (cluster) and -4.6% (awr) against the
         // 1024-spp reference.
         assert!(
             one < 0.985,

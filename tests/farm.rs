@@ -1,4 +1,4 @@
-//! What a render farm needs (issue 28): crops that tile a frame (`acr render --cropwindow` /
+//! What a render farm needs (docs/farm.md): crops that tile a frame (`acr render --cropwindow` /
 //! `--pixelbounds`) and `acr merge` (the EXR's display and data windows, merges equal to the
 //! whole-frame render byte for byte), sample ranges (`--sample-offset`, `--mergeable`) merged
 //! by their weights, clean stops on SIGTERM with partial writes, `--quick`.

@@ -1,7 +1,7 @@
-//! What a render's EXR carries beside R, G, B (issue 28): AOVs as channels with pbrt-v4's
-//! GBuffer names (`--aov albedo,normal,depth,variance,spp` without files), mergeable files with
-//! their variance moments, and the image streamed to a tev viewer (`--display-server`), checked
-//! against a stand-in for tev that decodes its protocol.
+//! What a render's EXR carries beside R, G, B (docs/cli.md, docs/farm.md): AOVs as channels with
+//! pbrt-v4's GBuffer names (`--aov albedo,normal,depth,variance,spp` without files), mergeable
+//! files with their variance moments, and the image streamed to a tev viewer (`--display-server`),
+//! checked against a stand-in for tev that decodes its protocol.
 
 mod common;
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Figures for issue 25: per scene, side by side, a 256-spp sobol+box render (the reference's
-stand-in), stratified+gaussian at 8 spp, cluster+polynomial (defaults) at 8 spp, and the
-clusters that fit used (--aov fitclusters: colours, borders dark), written to
+"""Figures for docs/reconstruction.md: per scene, side by side, a 256-spp sobol+box render (the
+reference's stand-in), stratified+gaussian at 8 spp, cluster+polynomial (defaults) at 8 spp, and
+the clusters that fit used (--aov fitclusters: colours, borders dark), written to
 OUT/figure-SCENE.png.
 
 usage: python3 bench/tools/features_figures.py [OUT_DIR]   (default docs/bench/features)

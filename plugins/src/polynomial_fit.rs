@@ -1,4 +1,4 @@
-//! The polynomial reconstruction's model of one cluster (ALGORITHM.md section 5, the paper's
+//! The polynomial reconstruction's model of one cluster (docs/algorithm.md §5, the paper's
 //! eq. 12-16): one additive Legendre polynomial over the cluster's dims,
 //! `l(u) = a0 + Σ_d Σ_{k=1..deg_d} a_dk P_k(ũ_d)`, with `ũ_d` the coordinate mapped from the
 //! cluster's extent to [-1, 1], fitted by weighted least squares over its cells (value: the
@@ -6,9 +6,9 @@
 //!
 //! A cell's row is the mean of each basis function over the cell's own samples, computed
 //! exactly from the cell's first two moments of the sample offsets (degree <= 2). For linear
-//! terms that is the basis at the samples' centroid, as ALGORITHM.md says; for the quadratic
-//! term it also counts the spread of the samples, so a noise-free quadratic field is fitted
-//! exactly from any number of samples per cell (at the centroid alone it is off by the
+//! terms that is the basis at the samples' centroid, as docs/algorithm.md §5 first read it; for the
+//! quadratic term it also counts the spread of the samples, so a noise-free quadratic field is
+//! fitted exactly from any number of samples per cell (at the centroid alone it is off by the
 //! samples' variance times the curvature).
 //!
 //! With features on, the model also has a linear term per first-hit feature (albedo, normal,

@@ -1,4 +1,4 @@
-//! The rendering space (ALGORITHM.md section 1): image dims `x`, `y` in pixels always, time `t`
+//! The rendering space (docs/algorithm.md §1): image dims `x`, `y` in pixels always, time `t`
 //! only when something moves during the shutter, lens `u`, `v` only with a lens; non-image dims
 //! normalised to [0, 1). Samplers produce points of this space and know nothing of the scene.
 

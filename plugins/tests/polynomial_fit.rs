@@ -201,7 +201,8 @@ fn the_fit_agrees_with_an_svd_solve_of_the_same_samples() {
         };
         let fit = Fit::new(&fit_cells(&cells), dims, &settings);
         assert_eq!(fit.degree(), 2);
-        // A dim with 2 cell positions gets degree 1 (ALGORITHM.md: no more than it can fit).
+        // A dim with 2 cell positions gets degree 1 (docs/algorithm.md §5: no more than it can
+        // fit).
         let degree: Vec<usize> = shape[..dims].iter().map(|&n| (n - 1).min(2)).collect();
 
         // The same problem from the raw samples: each cell's row is the mean of the basis over

@@ -1,4 +1,4 @@
-//! The adaptive samplers' two sample streams (issue 26, item 3): each stream's points are
+//! The adaptive samplers' two sample streams (docs/algorithm.md §8): each stream's points are
 //! decided from the other stream's values only, the budget is spent exactly, the streams are
 //! told apart by the index's parity, and the film's image is the mean of the two streams'.
 
@@ -65,7 +65,7 @@ fn a_streams_first_round_does_not_depend_on_its_own_values() {
     // Stream 0's values change; its first batch (the uniform first stage) and its first
     // adaptive round, planned from stream 1's values alone, stay. Later rounds may move: the
     // other stream's later points went where stream 0's values sent them (the second-order
-    // dependence the README states).
+    // dependence docs/rivals.md states).
     for name in ADAPTIVE {
         let (a, b) = (stream_0_batches(name, 0.0), stream_0_batches(name, 2.0));
         assert!(a.len() >= 2, "{name}: {} batches", a.len());

@@ -1,4 +1,4 @@
-//! A time limit that adapts (issue 26, item 4): told after a batch how many samples per pixel
+//! A time limit that adapts (docs/algorithm.md §9): told after a batch how many samples per pixel
 //! fit in the time ([`Sampler::plan_for`]), an adaptive sampler (the cluster sampler, gem, awr,
 //! mdas) ends its first stage at its share of them (not inside a pass) and gives the rest in
 //! rounds, exactly that budget in all.

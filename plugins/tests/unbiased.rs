@@ -1,4 +1,4 @@
-//! Adaptive sampling whose decisions never read the values they decide (issue 26, item 3):
+//! Adaptive sampling whose decisions never read the values they decide (docs/algorithm.md §8):
 //! the `unbiased` checkerboard of the cluster sampler, gem and awr, where a pixel's count
 //! comes from the other colour's first stage only, and every adaptive sampler's `pilot`
 //! stream, which alone decides where the adaptive stream's samples go.

@@ -81,7 +81,7 @@ pub struct Geometry {
 /// Above this many primitives a geometry's BVH is built by [`wide::build_wide`], below by
 /// obvhs's PLOC builder. The wide builder is 1.6x faster on a million triangles and traces as
 /// fast there; on small scenes PLOC's optimal wide collapse traces up to 8% faster (measured on
-/// instancing and pbrt-v3's Cornell box, README), and its build time is negligible.
+/// instancing and pbrt-v3's Cornell box, docs/BENCHMARKS.md), and its build time is negligible.
 const WIDE_BUILD_MIN: usize = 100_000;
 
 /// The BVH builders.

@@ -287,7 +287,7 @@ fn unsupported_parameters_warn_once_and_unknown_types_fail() {
     ));
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(w[0].message.contains("normalmap") && w[0].loc.is_some());
-    // bumpmap is built (issue 27): every material carries it.
+    // bumpmap is built (docs/pbrt-v3-compatibility.md): every material carries it.
     let bumped = m.iter().filter(|m| matches!(m, Material::Bumped { .. }));
     assert_eq!(bumped.count(), 2, "{m:?}");
 
@@ -301,13 +301,14 @@ fn unsupported_parameters_warn_once_and_unknown_types_fail() {
     ));
     assert_eq!(w.len(), 1);
     assert!(matches!(m.last().unwrap(), Material::Matte(_)));
-    // fourier reads its table (issue 27): without one, a located error.
+    // fourier reads its table (docs/pbrt-v3-compatibility.md): without one, a located error.
     let e = build_err(&format!(
         "Material \"fourier\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
     ));
     assert!(e.message().contains("bsdffile"), "{e}");
 
-    // translucent (issue 27): pbrt-v3's four lobes with its defaults, index 1.5.
+    // translucent (docs/pbrt-v3-compatibility.md): pbrt-v3's four lobes with its defaults, index
+    // 1.5.
     let (m, w) = build(&format!("Material \"translucent\"\n{SHAPE}"));
     assert!(w.is_empty(), "{w:?}");
     let b = m.last().unwrap().bsdf(&si());

@@ -145,7 +145,7 @@ fn a_time_limit_stops_at_a_whole_pass_and_the_image_stays_complete() {
     assert!(lit > 200 * 200 * 9 / 10, "{lit} lit pixels");
 }
 
-/// A time limit that adapts (issue 26, item 4): with `--spp 1024` the cluster sampler's first
+/// A time limit that adapts (docs/algorithm.md §9): with `--spp 1024` the cluster sampler's first
 /// stage would be 256 spp, longer than the limit, so planned for its budget it never adapts;
 /// planned for what its speed says fits (`--time-plan fit`, the default) it ends its first
 /// stage early, adapts in rounds, and stops in the time with every pixel sampled twice or more.

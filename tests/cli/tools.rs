@@ -41,7 +41,7 @@ fn diff_measures_the_error_between_two_images() {
     assert_eq!(v["mse"].as_f64(), Some(0.0));
     assert_eq!(v["relmse"].as_f64(), Some(0.0));
 
-    // Two renders with different seeds, against this test's own reckoning (ALGORITHM.md 7).
+    // Two renders with different seeds, against this test's own reckoning (docs/algorithm.md §7).
     let o = acr([
         OsStr::new("diff"),
         a.as_os_str(),

@@ -1,4 +1,4 @@
-//! The first clustering of a grid of cells (ALGORITHM.md sections 3 and 4): every cell's
+//! The first clustering of a grid of cells (docs/algorithm.md §3 and §4): every cell's
 //! level and features, their scales, the tolerance of eq. 10 and the clusters grown by flood
 //! fill. The cluster sampler runs it after its first stage; the polynomial reconstruction runs
 //! it on the film's cells after any other sampler.

@@ -1,5 +1,5 @@
-//! Clusters for the fit grown by noise (issue 25): neighbouring cells, then the clusters they
-//! form, merge while their mean luminances agree within their pooled noise,
+//! Clusters for the fit grown by noise (docs/algorithm.md §10): neighbouring cells, then the
+//! clusters they form, merge while their mean luminances agree within their pooled noise,
 //! |m_a - m_b| <= z sqrt(v_a / n_a + v_b / n_b). Noise merges; a step that stands above the
 //! noise does not. No size cap. The sampler's clusters still decide where samples go. With a
 //! feature tolerance (and sums that keep first-hit features), two groups merge only when their
@@ -189,8 +189,8 @@ pub fn grow_by_noise_with(
 /// features aside. The feature test leaves such clusters where the lens or the shutter blurs
 /// the features (a cell's mean features then differ from all its neighbours'), and fitted
 /// alone they are box filters of their own few samples: on motion-dof at 8 spp the clusters
-/// of one cell had 7.7x the Gaussian's squared error there (README). A small spot that
-/// stands above the noise stays apart.
+/// of one cell had 7.7x the Gaussian's squared error there (docs/reconstruction.md). A small spot
+/// that stands above the noise stays apart.
 fn absorb_small(
     pairs: &[(f64, u32, u32)],
     parent: &mut [u32],

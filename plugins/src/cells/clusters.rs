@@ -1,4 +1,4 @@
-//! Clusters of cells (ALGORITHM.md section 4, paper eq. 10-11): connected sets of cells with
+//! Clusters of cells (docs/algorithm.md §4, paper eq. 10-11): connected sets of cells with
 //! similar features, grown by flood fill and kept up to date as cells change.
 
 use super::cell_features::{CellFeature, CELL_FEATURE_LEN};

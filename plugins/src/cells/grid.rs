@@ -1,4 +1,4 @@
-//! The cell grid over the active dims (ALGORITHM.md section 2); each cell's running sums are
+//! The cell grid over the active dims (docs/algorithm.md §2); each cell's running sums are
 //! in `sums.rs`. Image dims are cut every `cellsize` pixels, each non-image dim into `bins`
 //! intervals; the non-image dims are innermost in the cell index, so a pixel's cells lie
 //! together in memory.

@@ -1,4 +1,4 @@
-//! `polynomial`: the paper's reconstruction (ALGORITHM.md section 5). Each cluster of cells is
+//! `polynomial`: the paper's reconstruction (docs/algorithm.md §5, §10). Each cluster of cells is
 //! fitted with one additive Legendre polynomial over the active dims (`crate::polynomial_fit`),
 //! and a pixel is the integral of the models over the cells it covers: for each cell, the
 //! share of the pixel's volume it covers times its cluster's mean over the overlap. After the
@@ -73,10 +73,11 @@ pub enum CellWeights {
 pub const FEATURE_NOISE_Z: f64 = 8.0;
 
 /// The features' tolerance when features are on and `featuretolerance` is not set: with every
-/// feature prefiltered, 0.2 measured below 0.1 and 0.3 on defocus at 8 spp (README).
+/// feature prefiltered, 0.2 measured below 0.1 and 0.3 on defocus at 8 spp
+/// (docs/reconstruction.md).
 pub const FEATURE_TOLERANCE: f64 = 0.2;
 
-/// The feature prefilter's radius in cells, by default. Measured (README, seeds 1-3, 8 spp,
+/// The feature prefilter's radius in cells, by default. Measured (seeds 1-3, 8 spp,
 /// cluster+polynomial over stratified+gaussian): radius 1 took depth-of-field from 0.54 to 0.45
 /// and motion-dof from 0.71 to 0.57 with motion blur and the Cornell box unchanged; radius 2
 /// lost a little of that.
@@ -84,12 +85,12 @@ pub const PREFILTER_RADIUS: u32 = 1;
 
 /// The feature prefilter's NL-means strength, by default: with every feature prefiltered, 2
 /// measured lowest of 1, 2 and 3 on defocus at 8 spp, and within 1.2% of 3 on motion-dof,
-/// where 1 was 14% higher (README).
+/// where 1 was 14% higher (docs/reconstruction.md).
 pub const PREFILTER_KAPPA: f64 = 2.0;
 
 /// `mincells` by default: noise clusters of fewer cells join a neighbour that agrees within
-/// the noise test. Measured (README, seeds 1-5, 8 spp): 16 lowered the MSE by 10% to 13% on
-/// motion blur, defocus, both and the room, and raised it 3% on the Cornell box.
+/// the noise test. Measured (docs/reconstruction.md, seeds 1-5, 8 spp): 16 lowered the MSE by 10%
+/// to 13% on motion blur, defocus, both and the room, and raised it 3% on the Cornell box.
 pub const MIN_CLUSTER_CELLS: u32 = 16;
 
 /// `significance` by default with features on: 0 (off). Keeping departures measured worse on

@@ -100,7 +100,7 @@ pub trait Sampler: Send {
 
     /// Plans for `spp` samples per pixel in all, at most its own budget: a time limit's
     /// estimate of what fits in the time left, made again after every batch
-    /// (`--time-limit`, issue 26, item 4), so that an adaptive sampler reaches its adaptive
+    /// (`--time-limit`, docs/algorithm.md §9), so that an adaptive sampler reaches its adaptive
     /// stage in the time rather than spending it on a first stage planned for its budget.
     /// Says whether it plans by it; by default it does not, and the time limit just stops it.
     fn plan_for(&mut self, spp: u32) -> bool {

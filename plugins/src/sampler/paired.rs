@@ -1,5 +1,5 @@
 //! Two streams of an adaptive sampler whose decisions never read the values they decide
-//! (issue 26, item 3). An adaptive sampler that decides a pixel's count from the samples that
+//! (docs/algorithm.md §8). An adaptive sampler that decides a pixel's count from the samples that
 //! then estimate it biases the image: where the rare outcome is the bright one, a pixel whose
 //! first samples agree looks settled and keeps its dark estimate. A point's stream is its
 //! sample index's parity and the film keeps the streams apart ([`Film::split_streams`]); the
@@ -11,7 +11,7 @@
 //!   adaptive. No path leads from a value to its own pixel's weight: unbiased.
 //! - `streams 2`: two half-budget instances, each learning only from the other's values, the
 //!   image their mean. After the first adaptive round a stream's values still reach its own
-//!   later rounds through where the other stream's points went (measured in the README).
+//!   later rounds through where the other stream's points went (measured: docs/rivals.md).
 
 use super::{
     alternate, pixel_samples, IndexStream, Sampler, SamplerBuild, SamplerReport, SamplerSetup,

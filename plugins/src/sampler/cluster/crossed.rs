@@ -1,4 +1,4 @@
-//! The cluster sampler without selection bias (`unbiased`, issue 26, item 3). A pixel whose
+//! The cluster sampler without selection bias (`unbiased`, docs/algorithm.md §8). A pixel whose
 //! count is decided from its own samples is biased: where the rare outcome is the bright one,
 //! a pixel whose first samples agree looks settled and keeps its dark estimate. Here the
 //! pixels are coloured as a checkerboard and two instances of the sampler share the work: each
@@ -7,7 +7,7 @@
 //! the plain mean of its own samples (one Owen-scrambled Sobol sequence, so they stay
 //! stratified) is unbiased. The decisions are made from the first stage only: learning from
 //! later rounds would let a pixel's values reach its own count through the counts of its
-//! neighbours (measured on the two-stream design; see the README).
+//! neighbours (measured on the two-stream design; see docs/rivals.md).
 
 use super::{ClusterSampler, Phase};
 use crate::cells::CellView;

@@ -1,4 +1,4 @@
-//! `cluster`: the paper's adaptive sampler (ALGORITHM.md sections 1 to 4). It samples every
+//! `cluster`: the paper's adaptive sampler (docs/algorithm.md §1 to §4). It samples every
 //! pixel `initspp` times (Owen-scrambled Sobol, stratified in every dim), groups the cells of
 //! the rendering space into clusters by their features, then spends the rest of the budget in
 //! rounds: the clusters of highest priority get a few samples each, spread over their cells;

@@ -1,4 +1,4 @@
-//! The cluster sampler under `--noise-threshold` (issue 26, item 5): a first stage of what
+//! The cluster sampler under `--noise-threshold` (docs/algorithm.md §9): a first stage of what
 //! every pixel must have, and each cluster's own relative error, by which a cluster settles
 //! when `settle` is on.
 

@@ -1,4 +1,4 @@
-//! The cluster sampler under a time limit that adapts (issue 26, item 4): the render loop
+//! The cluster sampler under a time limit that adapts (docs/algorithm.md §9): the render loop
 //! tells it, after every batch, how many samples per pixel its measured speed says fit in the
 //! time left, and it plans its first stage and its rounds for that instead of for its budget
 //! (planned for `--spp 64`, a first stage of 16 spp would spend the whole time and never

@@ -19,7 +19,7 @@ pub enum Priority {
     Paper,
 }
 
-/// The cluster sampler's knobs (ALGORITHM.md; `acr plugins` lists them with their defaults).
+/// The cluster sampler's knobs (docs/plugins.md; `acr plugins` lists them with their defaults).
 #[derive(Clone, Copy, Debug)]
 pub struct ClusterSettings {
     /// Samples per pixel, on average: the budget is spp × pixels.
@@ -75,8 +75,8 @@ impl ClusterSettings {
             spp,
             omega: 0.7,
             cell_size: 1.0,
-            // ALGORITHM.md's default is 2. Measured with acr bench over the 3D, 4D and 5D
-            // scenes at 4, 8 and 16 spp (geometric mean of the MSE ratio to
+            // Our first reading of the paper had 2 (docs/algorithm.md §2). Measured with acr bench
+            // over the 3D, 4D and 5D scenes at 4, 8 and 16 spp (geometric mean of the MSE ratio to
             // stratified+gaussian): bins 1 0.79 (worst case 0.93), 2 0.82 (1.22), 3 1.12
             // (1.50); with a splatting filter, cells cut in time and lens hold one or two
             // samples each and their features are mostly noise. bins 1 also has a quarter to
