@@ -1,5 +1,6 @@
-//! The render loop (ARCHITECTURE.md): batches of sample points, traced in parallel with rayon,
-//! added to the film in a fixed order, so the image depends on the scene, seed and budget only.
+//! The render loop (docs/architecture.md §3): batches of sample points, traced in parallel with
+//! rayon, added to the film in a fixed order, so the image depends on the scene, seed and
+//! budget only.
 
 use crate::camera::CameraSample;
 use crate::first_hit::{FeatureImage, FirstHit};

@@ -1,4 +1,4 @@
-//! The stats file (`--stats`): one JSON object, as ARCHITECTURE.md specifies.
+//! The stats file (`--stats`): one JSON object, as docs/cli.md lists its keys.
 
 use serde::Serialize;
 

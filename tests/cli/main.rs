@@ -1,5 +1,5 @@
 //! The `acr` command line, run as a process: `acr render` (outputs, stats file, determinism,
-//! errors) and `acr diff`, as ARCHITECTURE.md specifies them.
+//! errors) and `acr diff`, as docs/cli.md specifies them.
 
 mod aovs;
 mod errors;
