@@ -123,6 +123,34 @@ fn degenerate_shapes_are_skipped_with_a_warning_and_render_cleanly() {
     assert!(lum(&image) > 2.0 * lum(&clean));
 }
 
+/// Geometry whose coordinates are finite but huge (1e20: its box's area overflows f32) is
+/// skipped with a located warning: the BVH builder's costs would be infinite and it would
+/// pick no split (docs/architecture.md §5). The rest of the scene renders.
+#[test]
+fn geometry_beyond_the_bvh_range_is_skipped_with_a_warning() {
+    let world = "\
+        Shape \"trianglemesh\" \"integer indices\" [0 1 2  1 2 3]\n\
+        \"point3 P\" [1e20 0 0  -1 1 0  -1 0 0  0 0 1]\n\
+        AttributeBegin\nTranslate 1e20 0 0\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n\
+        ObjectBegin \"far\"\nShape \"sphere\" \"float radius\" 1\nObjectEnd\n\
+        AttributeBegin\nTranslate 0 0 -1e20\nObjectInstance \"far\"\nAttributeEnd\n";
+    let text = dim_scene("", world);
+    let (_, _, warnings) = build(&text, &Overrides::default(), 4);
+    let text_of: Vec<String> = warnings.iter().map(|w| w.to_string()).collect();
+    let far = |what: &str| {
+        text_of
+            .iter()
+            .filter(|w| w.contains(what) && w.contains("(the BVH's range)"))
+            .count()
+    };
+    assert_eq!(far("trianglemesh: 1 of 2 primitives"), 1, "{text_of:#?}");
+    assert_eq!(far("sphere: 1 of 1 primitives"), 1, "{text_of:#?}");
+    assert_eq!(far("1 object instances"), 1, "{text_of:#?}");
+    let (image, counts) = render_scene(&text, &Overrides::default(), 4);
+    assert_eq!(counts.dropped, 0);
+    assert!(image.iter().all(|p| p.is_finite()));
+}
+
 /// A 1e8-radiance spherical light beside the dim scene.
 fn bright_scene(film: &str) -> String {
     dim_scene(

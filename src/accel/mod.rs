@@ -397,9 +397,18 @@ pub struct Instance {
 }
 
 /// The scene's acceleration structure.
-/// Whether `[lo, hi]` is a box the BVH builder can take: finite corners, `lo <= hi`.
-pub fn finite_box(lo: Vec3, hi: Vec3) -> bool {
-    lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()
+/// The largest coordinate, in render space (camera at the origin), a box the BVH builder
+/// takes may have. Its build costs are surface areas times primitive counts, in f32: beyond
+/// this a scene's box's area times 2^32 primitives would overflow to infinity, and obvhs's
+/// build then picks no split (a panic, or a tree that loses primitives). Far beyond any real
+/// scene, which the camera-relative render space keeps near the origin.
+pub const MAX_COORDINATE: f32 = 1e12;
+
+/// Whether `[lo, hi]` is a box the BVH builder can take: finite corners within
+/// [`MAX_COORDINATE`] of the origin, `lo <= hi`.
+pub fn box_in_range(lo: Vec3, hi: Vec3) -> bool {
+    let within = |v: Vec3| v.is_finite() && v.abs().max_element() <= MAX_COORDINATE;
+    within(lo) && within(hi) && lo.cmple(hi).all()
 }
 
 #[derive(Default)]
@@ -416,8 +425,8 @@ pub struct Accel {
 
 impl Accel {
     /// Builds every BVH. Call once after adding everything. Gives the number of instances
-    /// dropped because their placement takes them beyond f32's range (the BVH builder needs
-    /// finite boxes).
+    /// dropped because their placement takes them beyond the BVH's range
+    /// ([`MAX_COORDINATE`]).
     pub fn build(&mut self) -> usize {
         self.world.build();
         for g in &mut self.objects {
@@ -431,7 +440,7 @@ impl Accel {
             let (lo, hi) = i
                 .placement
                 .world_bounds(objects[i.object as usize].bounds());
-            finite_box(lo, hi)
+            box_in_range(lo, hi)
         });
         let dropped = before - self.instances.len();
         if self.instances.is_empty() {

@@ -22,8 +22,9 @@ impl Builder<'_> {
             self.warnings.push(Warning {
                 loc: None,
                 message: format!(
-                    "{dropped} object instances are placed beyond the range of 32-bit floats \
-                     and are skipped"
+                    "{dropped} object instances are placed farther than {:e} from the camera \
+                     (the BVH's range) and are skipped",
+                    crate::accel::MAX_COORDINATE
                 ),
             });
         }

@@ -350,8 +350,8 @@ impl Builder<'_> {
         })
     }
 
-    /// `prims` without those whose coordinates lie beyond f32's range (or are NaN) relative
-    /// to the camera: no box holds them. Warns of those dropped.
+    /// `prims` without those whose coordinates lie beyond the BVH's range
+    /// ([`crate::accel::MAX_COORDINATE`] from the camera) or are NaN. Warns of those dropped.
     fn within_range(
         &mut self,
         geom: &Geometry,
@@ -361,16 +361,17 @@ impl Builder<'_> {
         let before = prims.len();
         prims.retain(|&k| {
             let (lo, hi) = geom.kind_bounds(k);
-            crate::accel::finite_box(lo, hi)
+            crate::accel::box_in_range(lo, hi)
         });
         if prims.len() < before {
             self.warnings.push(Warning::at(
                 &p.loc,
                 format!(
-                    "{}: {} of {before} primitives lie beyond the range of 32-bit floats \
-                     seen from the camera, or have NaN coordinates, and are skipped",
+                    "{}: {} of {before} primitives lie farther than {:e} from the camera \
+                     (the BVH's range), or have NaN coordinates, and are skipped",
                     p.kind,
-                    before - prims.len()
+                    before - prims.len(),
+                    crate::accel::MAX_COORDINATE
                 ),
             ));
         }
