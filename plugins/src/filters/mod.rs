@@ -59,6 +59,14 @@ pub trait Filter: Send + Sync {
     fn report(&self) -> FilterReport {
         FilterReport::default()
     }
+
+    /// The reconstruction's own estimate of each pixel's squared error (row-major over the
+    /// cropped film, in the image's units squared) from the film as it stands, for a sampler
+    /// that sends samples where the reconstructed image is worst (docs/reconstruction.md);
+    /// None for a filter that makes no such estimate.
+    fn estimated_error(&self, _film: &Film) -> Option<Vec<f32>> {
+        None
+    }
 }
 
 /// A reconstruction's figures for the stats file.
