@@ -237,7 +237,9 @@ pub fn open_file(path: &Path, kind: FileKind) -> std::io::Result<(std::fs::File,
 }
 
 /// Reads a whole file named in a scene, checked as [`open_file`] checks it; the read is
-/// bounded again in case the file grows meanwhile.
+/// bounded again in case the file grows meanwhile. A name ending in `.gz` (any case) is
+/// decompressed, as pbrt-v4 reads `.pbrt.gz` and `.ply.gz`; the limit then bounds the
+/// decompressed bytes too, so that a small file cannot expand without end.
 pub fn read_file(path: &Path, kind: FileKind) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let (file, len) = open_file(path, kind)?;
@@ -247,7 +249,27 @@ pub fn read_file(path: &Path, kind: FileKind) -> std::io::Result<Vec<u8>> {
     if bytes.len() as u64 > limit {
         return Err(too_long(bytes.len() as u64, kind));
     }
-    Ok(bytes)
+    if !is_gzip_name(path) {
+        return Ok(bytes);
+    }
+    let mut text = Vec::with_capacity(bytes.len().saturating_mul(4));
+    flate2::read::MultiGzDecoder::new(bytes.as_slice())
+        .take(limit + 1)
+        .read_to_end(&mut text)
+        .map_err(|e| refused(format!("not a readable gzip file: {e}")))?;
+    if text.len() as u64 > limit {
+        return Err(refused(format!(
+            "more than {limit} bytes once decompressed, more than a {} may have",
+            kind.name()
+        )));
+    }
+    Ok(text)
+}
+
+/// Whether `path` names a gzip-compressed file (`.gz`, any case).
+pub fn is_gzip_name(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
 }
 
 /// A refusal by [`open_file`], with its reason.
@@ -307,6 +329,40 @@ mod tests {
             e.to_string().contains("more than a spectrum file may have"),
             "{e}"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn read_file_decompresses_gz_names_and_refuses_what_is_not_gzip() {
+        use std::io::Write;
+        let dir = temp_dir("gz");
+        let text = b"WorldBegin\nShape \"sphere\"\nWorldEnd\n";
+        let gz = dir.join("s.pbrt.GZ");
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(text).unwrap();
+        std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+        assert_eq!(read_file(&gz, FileKind::Scene).unwrap(), text);
+        // Without the suffix the bytes are what they are.
+        let raw = dir.join("s.pbrt");
+        std::fs::copy(&gz, &raw).unwrap();
+        assert_ne!(read_file(&raw, FileKind::Scene).unwrap(), text);
+        // A `.gz` that is not gzip, and one cut short, are errors that say so.
+        let bad = dir.join("bad.pbrt.gz");
+        std::fs::write(&bad, text).unwrap();
+        let e = read_file(&bad, FileKind::Scene).unwrap_err();
+        assert!(e.to_string().contains("not a readable gzip file"), "{e}");
+        let gz_bytes = std::fs::read(&gz).unwrap();
+        std::fs::write(&bad, &gz_bytes[..gz_bytes.len() - 6]).unwrap();
+        let e = read_file(&bad, FileKind::Scene).unwrap_err();
+        assert!(e.to_string().contains("not a readable gzip file"), "{e}");
+        // The limit bounds the decompressed bytes: 17 MB of zeros is a small file.
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        enc.write_all(&vec![0u8; (17 << 20) as usize]).unwrap();
+        let bomb = dir.join("big.spd.gz");
+        std::fs::write(&bomb, enc.finish().unwrap()).unwrap();
+        assert!(std::fs::metadata(&bomb).unwrap().len() < FileKind::Spectrum.max_bytes());
+        let e = read_file(&bomb, FileKind::Spectrum).unwrap_err();
+        assert!(e.to_string().contains("once decompressed"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
