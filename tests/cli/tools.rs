@@ -246,7 +246,7 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     assert_eq!(
         lines[0],
         "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
-         mean_ratio,seeds"
+         mean_ratio,seeds,command_seconds,command_time"
     );
     assert_eq!(lines.len(), 11);
     let ok: Vec<&str> = lines[1..]
@@ -287,6 +287,87 @@ fn bench_writes_csv_plot_and_report_and_survives_a_failing_method() {
     // The reference is cached: a second run does not render it again.
     let err = run();
     assert!(!err.contains("rendering the reference"), "{err}");
+}
+
+#[test]
+fn bench_runs_an_external_command_as_a_method_and_skips_one_whose_program_is_absent() {
+    let dir = TempDir::new("bench-external");
+    dir.write("s.pbrt", &small_scene(""));
+    // `cp` through sh: the command's image is the render itself, so its MSE is the plain
+    // method's; it prints 0.01 as its seconds.
+    let copy = "command = [\"sh\", \"-c\", \"cp \\\"$0\\\" \\\"$1\\\" && echo 0.01\", \"{in}\", \"{out}\"]";
+    let manifest = dir.write(
+        "m.toml",
+        &format!(
+            "seed = 5\nthreads = 2\n[budgets]\nspp = [2]\nequal_time = true\n\
+             [reference]\nsampler = \"sobol\"\nfilter = \"box\"\nspp = 16\n\
+             [[scene]]\nname = \"small\"\npath = \"s.pbrt\"\npixelbounds = [4, 20, 2, 14]\n\
+             [[method]]\nlabel = \"random+box\"\nsampler = \"random\"\nfilter = \"box\"\n\
+             [[method]]\nlabel = \"stratified+box\"\nsampler = \"stratified\"\nfilter = \"box\"\n\
+             [[method]]\nlabel = \"copy\"\nsampler = \"stratified\"\nfilter = \"box\"\n\
+             aov = \"albedo,normal\"\noutput = \"exr\"\ntime = \"printed\"\n{copy}\n\
+             [[method]]\nlabel = \"absent\"\ncommand = [\"./no-such-denoiser\", \"{{in}}\", \"{{out}}\"]\n\
+             [[method]]\nlabel = \"broken\"\ncommand = [\"sh\", \"-c\", \"exit 4\", \"{{in}}\", \"{{out}}\"]\n"
+        ),
+    );
+    let out = dir.join("out");
+    let err = bench_ok(&manifest, &out);
+    assert!(
+        err.contains(
+            "warning: method \"absent\" skipped: program \"./no-such-denoiser\" not found"
+        ),
+        "{err}"
+    );
+    assert!(err.contains("failed, 2 skipped"), "{err}");
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let row = |m: &str, mode: &str| -> Vec<String> {
+        let l = csv
+            .lines()
+            .find(|l| l.starts_with(&format!("small,{m},{mode},2,")))
+            .unwrap_or_else(|| panic!("{m} {mode}: {csv}"));
+        l.split(',').map(str::to_owned).collect()
+    };
+    let plain = row("stratified+box", "equal-spp");
+    let copied = row("copy", "equal-spp");
+    // The same image, scored alike; the command's printed seconds added and recorded.
+    assert_eq!(copied[11], "ok", "{csv}");
+    assert_eq!(copied[7], plain[7], "MSE: {csv}");
+    assert_eq!(
+        (copied[14].as_str(), copied[15].as_str()),
+        ("0.010000", "printed")
+    );
+    assert!(plain[14].is_empty() && plain[15].is_empty(), "{csv}");
+    // The crop: 16 x 12 pixels.
+    assert_eq!(copied[5], (2 * 16 * 12).to_string(), "{csv}");
+    let timed = row("copy", "equal-time");
+    assert_eq!(timed[11], "ok", "{csv}");
+    assert_eq!(timed[14], "0.010000", "{csv}");
+    for mode in ["equal-spp", "equal-time"] {
+        let absent = row("absent", mode);
+        assert!(absent[11].starts_with("\"skipped: program"), "{csv}");
+        let broken = row("broken", mode);
+        assert!(broken[11].starts_with("\"failed:"), "{csv}");
+    }
+    assert!(
+        csv.contains("method \"\"broken\"\": \"\"sh\"\" exit 4"),
+        "{csv}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("**2 runs failed**"), "{report}");
+    assert!(
+        report.contains("**`absent` was skipped: program"),
+        "{report}"
+    );
+    assert!(report.contains("- `copy`: `sh -c"), "{report}");
+    assert!(report.contains("| 2 | absent | skipped |"), "{report}");
+    // The images side by side, and their crop, at the budget.
+    for name in ["small-images-equal-spp-2", "small-images-equal-time-2"] {
+        for file in [format!("{name}.png"), format!("{name}-crop.png")] {
+            let png = std::fs::read(out.join(&file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+            assert!(png.starts_with(b"\x89PNG"), "{file}");
+            assert!(report.contains(&file), "{report}");
+        }
+    }
 }
 
 #[test]

@@ -24,25 +24,48 @@ fn equal_time_spp(spp: u32, baseline: Option<f64>, own: Option<f64>) -> u32 {
     }
 }
 
+/// What a method's own equal-spp run at a budget spent: its render (with reconstruction) and
+/// an external method's command.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Spent {
+    /// Render plus reconstruction seconds.
+    pub(super) render: f64,
+    /// The command's seconds (0 without one).
+    pub(super) command: f64,
+}
+
 /// A compared run's spp and time limit: at equal spp the budget; at equal time the first
-/// method's seconds at this budget as the limit (`seconds.0`, an error where it failed) with the
-/// spp that `time_limited_spp` names or the method's own equal-spp seconds (`seconds.1`) say fit.
+/// method's seconds at this budget (`baseline`, an error where it failed) less what the
+/// method's command took in its own equal-spp run, as the render's limit, with the spp that
+/// `time_limited_spp` names or that the method's own render seconds (`own`) say fit. An
+/// external method (`external`) without its own run cannot know its command's cost: an error.
 pub(super) fn run_budget(
     mode: Mode,
     spp: u32,
     budgets: &Budgets,
-    seconds: (Option<f64>, Option<f64>),
+    baseline: Option<f64>,
+    own: Option<Spent>,
+    external: bool,
 ) -> Result<(u32, Option<f64>), String> {
-    match (mode, seconds) {
-        (Mode::EqualSpp, _) => Ok((spp, None)),
-        (Mode::EqualTime, (None, _)) => Err("the first method failed at this budget".to_owned()),
-        (Mode::EqualTime, (Some(baseline), own)) => Ok((
-            budgets
-                .time_limited_spp
-                .unwrap_or_else(|| equal_time_spp(spp, Some(baseline), own)),
-            Some(baseline),
-        )),
+    if mode == Mode::EqualSpp {
+        return Ok((spp, None));
     }
+    let baseline = baseline.ok_or("the first method failed at this budget")?;
+    if external && own.is_none() {
+        return Err("its equal-spp run failed, so its command's time is unknown".to_owned());
+    }
+    let command = own.map_or(0.0, |o| o.command);
+    let limit = baseline - command;
+    if limit <= 0.0 {
+        return Err(format!(
+            "its command took {command:.3} s, no less than the first method's {baseline:.3} s: \
+             no time is left to render"
+        ));
+    }
+    let spp = budgets
+        .time_limited_spp
+        .unwrap_or_else(|| equal_time_spp(spp, Some(limit), own.map(|o| o.render)));
+    Ok((spp, Some(limit)))
 }
 
 #[cfg(test)]
@@ -68,17 +91,33 @@ mod tests {
             equal_time: true,
             time_limited_spp: None,
         };
-        let run = |mode, seconds, b: &Budgets| run_budget(mode, 8, b, seconds);
+        let spent = |render, command| Some(Spent { render, command });
+        let run = |mode, base, own, b: &Budgets| run_budget(mode, 8, b, base, own, false);
         assert_eq!(
-            run(Mode::EqualSpp, (Some(1.0), None), &budgets),
+            run(Mode::EqualSpp, Some(1.0), None, &budgets),
             Ok((8, None))
         );
         // Twice as slow as the first method: half the spp, in its time.
-        let half = (Some(1.0), Some(2.0));
-        assert_eq!(run(Mode::EqualTime, half, &budgets), Ok((4, Some(1.0))));
-        assert!(run(Mode::EqualTime, (None, Some(2.0)), &budgets)
+        let half = spent(2.0, 0.0);
+        assert_eq!(
+            run(Mode::EqualTime, Some(1.0), half, &budgets),
+            Ok((4, Some(1.0)))
+        );
+        assert!(run(Mode::EqualTime, None, spent(2.0, 0.0), &budgets)
             .is_err_and(|e| e.contains("first method failed")));
         budgets.time_limited_spp = Some(64);
-        assert_eq!(run(Mode::EqualTime, half, &budgets), Ok((64, Some(1.0))));
+        assert_eq!(
+            run(Mode::EqualTime, Some(1.0), half, &budgets),
+            Ok((64, Some(1.0)))
+        );
+        budgets.time_limited_spp = None;
+        // An external method: its command's seconds come off the render's limit, and the spp
+        // fit the render's share.
+        let external = |base, own| run_budget(Mode::EqualTime, 8, &budgets, base, own, true);
+        let (spp, limit) = external(Some(2.0), spent(1.0, 0.5)).unwrap();
+        assert_eq!(spp, 12);
+        assert!((limit.unwrap() - 1.5).abs() < 1e-12);
+        assert!(external(Some(2.0), spent(1.0, 2.0)).is_err_and(|e| e.contains("no time")));
+        assert!(external(Some(2.0), None).is_err_and(|e| e.contains("unknown")));
     }
 }

@@ -2,11 +2,27 @@
 //! are its own and a crash is only a failed row; what its stats file reports, and its image
 //! measured against the reference.
 
+use super::external::run_command;
 use super::{Measured, Method, SamplerCost};
 use crate::image_io::{read_image, RgbImage};
 use crate::metrics::compare;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// The image a run of `method` into `output` is scored on: the render, or for an external
+/// method its command's `{out}` (the render then goes to [`command_input`]).
+pub(super) fn scored_path(method: &Method, output: &Path) -> PathBuf {
+    if method.is_external() {
+        output.with_extension(method.output.unwrap_or_default().extension())
+    } else {
+        output.to_owned()
+    }
+}
+
+/// Where an external method's render of a run into `output` goes: its command's `{in}`.
+pub(super) fn command_input(output: &Path) -> PathBuf {
+    output.with_extension("input.exr")
+}
 
 /// What `acr render` reported of one run.
 pub(super) struct RunOutput {
@@ -35,6 +51,8 @@ pub(super) struct RenderRun<'a> {
     pub(super) seed: u64,
     /// Worker threads (default: every core).
     pub(super) threads: Option<u32>,
+    /// The scene's `--pixelbounds`, if it is cropped.
+    pub(super) pixelbounds: Option<[u32; 4]>,
 }
 
 impl RenderRun<'_> {
@@ -100,25 +118,43 @@ impl RenderRun<'_> {
         for s in &method.set {
             cmd.arg("--set").arg(s);
         }
+        if let Some(aov) = &method.aov {
+            cmd.arg("--aov").arg(aov);
+        }
+        if let Some([x0, x1, y0, y1]) = self.pixelbounds {
+            cmd.arg("--pixelbounds").arg(format!("{x0},{x1},{y0},{y1}"));
+        }
         if let Some(t) = self.threads {
             cmd.arg("--threads").arg(t.to_string());
         }
         cmd
     }
 
-    /// One run into `output`, measured against `reference`.
+    /// One run into `output`, measured against `reference`; an external method's command
+    /// runs in `base` (the manifest's folder) on the render, and its seconds are added.
     pub(super) fn measure(
         &self,
         output: &Path,
         spp: u32,
         time_limit: Option<f64>,
         reference: &RgbImage,
+        base: &Path,
     ) -> Result<Measured, String> {
-        let r = self.run(output, spp, time_limit, false)?;
-        let img = read_image(output, false).map_err(|e| format!("{}: {e}", output.display()))?;
+        let scored = scored_path(self.method, output);
+        let (r, command) = if self.method.is_external() {
+            let input = command_input(output);
+            let r = self.run(&input, spp, time_limit, false)?;
+            (r, Some(run_command(self.method, base, &input, &scored)?))
+        } else {
+            (self.run(output, spp, time_limit, false)?, None)
+        };
+        let img = read_image(&scored, false).map_err(|e| format!("{}: {e}", scored.display()))?;
         let metrics = compare(&img, reference)?;
+        let command_seconds = command.map(|c| c.seconds);
         Ok(Measured {
-            seconds: r.seconds,
+            seconds: r.seconds + command_seconds.unwrap_or(0.0),
+            command_seconds,
+            command_time: command.map(|_| self.method.time.unwrap_or_default()),
             samples: r.samples,
             spp_reached: r.samples as f64 / r.pixels.max(1) as f64,
             metrics,

@@ -33,6 +33,7 @@ pub(super) fn measure_costs(
                     method,
                     seed: m.seed,
                     threads: m.threads,
+                    pixelbounds: scene.pixelbounds,
                 };
                 let outcome = (0..spec.runs)
                     .map(|_| {

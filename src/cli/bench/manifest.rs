@@ -102,6 +102,10 @@ pub struct SceneEntry {
     /// Its reference (else the manifest's).
     #[serde(default)]
     pub reference: Option<Reference>,
+    /// `--pixelbounds X0,X1,Y0,Y1` of every render of it, the reference's included: a crop
+    /// of a large image that fits the bench's time.
+    #[serde(default)]
+    pub pixelbounds: Option<[u32; 4]>,
 }
 
 /// A scene's reference image: a file, or a render by one of the methods at a high budget.
@@ -144,12 +148,13 @@ impl Reference {
             Reference::Render {
                 method: Some(label),
                 ..
-            } => methods
-                .iter()
-                .find(|m| &m.label == label)
-                .cloned()
-                .map(Some)
-                .ok_or_else(|| format!("names method \"{label}\", which is not listed")),
+            } => match methods.iter().find(|m| &m.label == label) {
+                None => Err(format!("names method \"{label}\", which is not listed")),
+                Some(m) if m.is_external() => Err(format!(
+                    "names method \"{label}\", which runs a command: a reference is acr's render"
+                )),
+                Some(m) => Ok(Some(m.clone())),
+            },
             Reference::Render {
                 method: None,
                 sampler,
@@ -163,14 +168,15 @@ impl Reference {
                 filter: filter.clone(),
                 integrator: integrator.clone(),
                 set: set.clone(),
-                time_plan: None,
+                ..Method::default()
             })),
         }
     }
 }
 
-/// A sampler + filter (+ integrator) with parameters, under a label.
-#[derive(Clone, Debug, Deserialize)]
+/// A sampler + filter (+ integrator) with parameters, under a label; with `command`, an
+/// external program run on its render (docs/BENCHMARKS.md, "External methods").
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Method {
     /// Its name in the report (`stratified+box`).
@@ -190,6 +196,94 @@ pub struct Method {
     /// `--time-plan` of its time-limited runs (default: `acr render`'s, `fit`).
     #[serde(default)]
     pub time_plan: Option<TimePlan>,
+    /// `--aov` channels its render writes into its EXR (what a command reads).
+    #[serde(default)]
+    pub aov: Option<String>,
+    /// A program and its arguments, run in the manifest's folder on the render: `{in}` is
+    /// replaced by the rendered EXR, `{out}` by the image it must write, which is scored.
+    #[serde(default)]
+    pub command: Option<Vec<String>>,
+    /// How the command's seconds are counted (default: its whole process's wall time).
+    #[serde(default)]
+    pub time: Option<CommandTime>,
+    /// The format of the command's `{out}`: `pfm` (default) or `exr`.
+    #[serde(default)]
+    pub output: Option<CommandOutput>,
+}
+
+/// How an external command's seconds are counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CommandTime {
+    /// The wall time of its whole process, start-up included.
+    #[default]
+    Wall,
+    /// The seconds it prints on its last line of standard output (its own measure, without
+    /// an interpreter's start-up).
+    Printed,
+}
+
+impl CommandTime {
+    /// Its name in the manifest and the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            CommandTime::Wall => "wall",
+            CommandTime::Printed => "printed",
+        }
+    }
+}
+
+/// The format of an external command's `{out}` image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CommandOutput {
+    /// Portable float map.
+    #[default]
+    Pfm,
+    /// OpenEXR.
+    Exr,
+}
+
+impl CommandOutput {
+    /// The file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            CommandOutput::Pfm => "pfm",
+            CommandOutput::Exr => "exr",
+        }
+    }
+}
+
+impl Method {
+    /// Whether it runs an external command on its render.
+    pub fn is_external(&self) -> bool {
+        self.command.is_some()
+    }
+}
+
+/// A method's command-related keys, checked: a program, `{in}` and `{out}` each named, and
+/// `time`/`output` only with a command.
+fn check_command(meth: &Method) -> Result<(), String> {
+    let label = &meth.label;
+    match &meth.command {
+        None if meth.time.is_some() || meth.output.is_some() => Err(format!(
+            "method \"{label}\": `time` and `output` need a `command`"
+        )),
+        None => Ok(()),
+        Some(argv) if argv.first().is_none_or(|p| p.trim().is_empty()) => {
+            Err(format!("method \"{label}\": `command` must name a program"))
+        }
+        Some(argv) => {
+            for slot in ["{in}", "{out}"] {
+                if !argv.iter().skip(1).any(|a| a.contains(slot)) {
+                    return Err(format!(
+                        "method \"{label}\": `command` must pass {slot} to its program"
+                    ));
+                }
+            }
+            Ok(())
+        }
+    }
 }
 
 /// How a run was budgeted.
@@ -281,6 +375,7 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
                 meth.label
             ));
         }
+        check_command(meth).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     for s in &m.scenes {
         let Some(r) = s.reference.as_ref().or(m.reference.as_ref()) else {
@@ -371,6 +466,66 @@ mod tests {
         std::fs::write(&p, with("time_limited_spp = 0", "")).unwrap();
         let e = read_manifest(&p).unwrap_err();
         assert!(e.contains("time_limited_spp is out of range"), "{e}");
+        // External methods: the command must name a program, {in} and {out}; `time` and
+        // `output` need a command; a reference cannot be one.
+        std::fs::write(
+            &p,
+            with(
+                "",
+                "aov = \"albedo,normal\"\ncommand = [\"sh\", \"-c\", \"cp $0 $1\", \"{in}\", \"{out}\"]\n\
+                 time = \"printed\"\noutput = \"exr\"",
+            ),
+        )
+        .unwrap();
+        let meth = &read_manifest(&p).unwrap().methods[0];
+        assert!(meth.is_external());
+        assert_eq!(meth.command.as_ref().map(Vec::len), Some(5));
+        assert_eq!(meth.aov.as_deref(), Some("albedo,normal"));
+        assert_eq!(meth.time, Some(CommandTime::Printed));
+        assert_eq!(meth.output.map(CommandOutput::extension), Some("exr"));
+        for (method, message) in [
+            (
+                "command = []",
+                "method \"x\": `command` must name a program",
+            ),
+            (
+                "command = [\" \", \"{in}\", \"{out}\"]",
+                "must name a program",
+            ),
+            (
+                "command = [\"cp\", \"{in}\"]",
+                "`command` must pass {out} to its program",
+            ),
+            (
+                "command = [\"{in}\", \"{out}\"]",
+                "`command` must pass {in} to its program",
+            ),
+            ("time = \"wall\"", "`time` and `output` need a `command`"),
+            ("output = \"pfm\"", "`time` and `output` need a `command`"),
+        ] {
+            std::fs::write(&p, with("", method)).unwrap();
+            let e = read_manifest(&p).unwrap_err();
+            assert!(e.contains(message), "{method}: {e}");
+        }
+        std::fs::write(
+            &p,
+            with(
+                "",
+                "command = [\"cp\", \"{in}\", \"{out}\"]\ntime = \"cpu\"",
+            ),
+        )
+        .unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("m.toml:13:8:") && e.contains("printed"), "{e}");
+        std::fs::write(
+            &p,
+            "[budgets]\nspp = [1]\n[[scene]]\nname = \"a\"\npath = \"a.pbrt\"\n\
+             reference = { method = \"x\", spp = 4 }\npixelbounds = [0, 4, 0, 2]\n\
+             [[method]]\nlabel = \"x\"\ncommand = [\"cp\", \"{in}\", \"{out}\"]\n",
+        )
+        .unwrap();
+        let e = read_manifest(&p).unwrap_err();
+        assert!(e.contains("which runs a command"), "{e}");
         std::fs::write(&p, with("", "time_plan = \"soon\"")).unwrap();
         let e = read_manifest(&p).unwrap_err();
         assert!(e.contains("m.toml:12:13:") && e.contains("fit"), "{e}");

@@ -6,8 +6,9 @@
 //!
 //! One file per concept: the manifest (`manifest.rs`), the run loop (`run.rs`), the budgets
 //! of compared runs (`budget.rs`), one render as a child process (`child.rs`), the references
-//! (`reference.rs`), the sampler-cost measures (`costs.rs`), what is measured (`results.rs`)
-//! and what is written (`report.rs`).
+//! (`reference.rs`), the sampler-cost measures (`costs.rs`), an external command as a method
+//! (`external.rs`), what is measured (`results.rs`), what is written (`report.rs`) and the
+//! images side by side (`gallery.rs`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -15,6 +16,8 @@ use std::process::Command;
 mod budget;
 mod child;
 mod costs;
+mod external;
+mod gallery;
 mod manifest;
 mod reference;
 mod report;
@@ -82,7 +85,11 @@ pub fn command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
     };
     let results = run_bench(manifest, &opts)?;
     let rows = &results.rows;
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    let skipped = rows
+        .iter()
+        .filter(|r| r.outcome.as_ref().is_err_and(|e| e.starts_with("skipped:")))
+        .count();
+    let failed = rows.iter().filter(|r| r.outcome.is_err()).count() - skipped;
     let costs = &results.costs;
     let costs_failed = costs.iter().filter(|c| c.outcome.is_err()).count();
     let cost_note = if costs.is_empty() {
@@ -94,7 +101,7 @@ pub fn command(manifest: &Path, out: Option<PathBuf>) -> Result<(), String> {
         )
     };
     eprintln!(
-        "{} runs, {failed} failed{cost_note} -> {}",
+        "{} runs, {failed} failed, {skipped} skipped{cost_note} -> {}",
         rows.len(),
         out.join("report.md").display()
     );

@@ -15,8 +15,15 @@ fn fnv1a(h: &mut u64, bytes: &[u8]) {
     }
 }
 
-/// The cache key of a reference: every file the scene reads, the method, budget and seed.
-fn reference_key(scene: &Path, method: &Method, spp: u32, seed: u64) -> Result<u64, String> {
+/// The cache key of a reference: every file the scene reads, the method, budget, seed and
+/// crop.
+fn reference_key(
+    scene: &Path,
+    method: &Method,
+    spp: u32,
+    seed: u64,
+    pixelbounds: Option<[u32; 4]>,
+) -> Result<u64, String> {
     let desc = acr_parser::parse_file(scene).map_err(|e| e.to_string())?;
     let mut h = 0xcbf2_9ce4_8422_2325u64;
     for f in &desc.files {
@@ -47,6 +54,10 @@ fn reference_key(scene: &Path, method: &Method, spp: u32, seed: u64) -> Result<u
         env!("CARGO_PKG_VERSION")
     );
     fnv1a(&mut h, m.as_bytes());
+    // Uncropped keys stay those of before, so that cached references remain valid.
+    if let Some(b) = pixelbounds {
+        fnv1a(&mut h, format!("|pixelbounds {b:?}").as_bytes());
+    }
     Ok(h)
 }
 
@@ -69,7 +80,7 @@ pub(super) fn reference_image(
         Reference::Render { spp, .. } => {
             let meth = spec.method(&m.methods)?.ok_or("no method")?;
             let meth = &meth;
-            let key = reference_key(scene_path, meth, *spp, m.seed)?;
+            let key = reference_key(scene_path, meth, *spp, m.seed, scene.pixelbounds)?;
             let path = cache.join(format!("{}-{key:016x}.exr", file_safe(&scene.name)));
             if !path.is_file() {
                 eprintln!(
@@ -87,6 +98,7 @@ pub(super) fn reference_image(
                     method: meth,
                     seed: m.seed,
                     threads: m.threads,
+                    pixelbounds: scene.pixelbounds,
                 };
                 run.run(&tmp, *spp, None, false)?;
                 std::fs::rename(&tmp, &path).map_err(|e| format!("{}: {e}", path.display()))?;

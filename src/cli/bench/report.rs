@@ -47,11 +47,17 @@ fn mean_ratio(m: &crate::metrics::Metrics) -> f64 {
     }
 }
 
-/// The CSV: one row per run, failed runs with their reason.
+/// Whether a row's error is a skip (its program absent on this machine), not a failure.
+fn is_skip(e: &str) -> bool {
+    e.starts_with("skipped:")
+}
+
+/// The CSV: one row per run, failed runs with their reason, skipped ones with theirs; an
+/// external method's command seconds (part of `seconds`) and how they were counted.
 pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
     let mut s = String::from(
         "scene,method,mode,spp,seconds,samples,spp_reached,mse,relmse,psnr,peak_rss_mb,status,\
-         mean_ratio,seeds\n",
+         mean_ratio,seeds,command_seconds,command_time\n",
     );
     for r in rows {
         let head = format!(
@@ -65,7 +71,7 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
             Ok(m) => {
                 let _ = writeln!(
                     s,
-                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok,{:.5},{}",
+                    "{head},{:.6},{},{:.3},{:.6e},{:.6e},{:.4},{:.1},ok,{:.5},{},{},{}",
                     m.seconds,
                     m.samples,
                     m.spp_reached,
@@ -74,16 +80,19 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
                     m.metrics.psnr,
                     m.peak_rss_mb,
                     mean_ratio(&m.metrics),
-                    r.seeds
+                    r.seeds,
+                    m.command_seconds
+                        .map_or(String::new(), |c| format!("{c:.6}")),
+                    m.command_time.map_or("", |t| t.name())
                 );
             }
             Err(e) => {
-                let _ = writeln!(
-                    s,
-                    "{head},,,,,,,,{},,{}",
-                    csv_field(&format!("failed: {e}")),
-                    r.seeds
-                );
+                let status = if is_skip(e) {
+                    e.clone()
+                } else {
+                    format!("failed: {e}")
+                };
+                let _ = writeln!(s, "{head},,,,,,,,{},,{},,", csv_field(&status), r.seeds);
             }
         }
     }
@@ -131,9 +140,25 @@ pub fn report_markdown(
 ) -> String {
     let mut s = String::new();
     write_setting(&mut s, m, manifest, opts);
-    let failed = rows.iter().filter(|r| r.outcome.is_err()).count();
+    let failed = rows
+        .iter()
+        .filter(|r| r.outcome.as_ref().is_err_and(|e| !is_skip(e)))
+        .count();
     if failed > 0 {
         let _ = writeln!(s, "**{failed} runs failed**; see `results.csv`.\n");
+    }
+    for (meth, why) in m.methods.iter().filter_map(|meth| {
+        rows.iter()
+            .find(|r| r.method == meth.label)
+            .and_then(|r| r.outcome.as_ref().err())
+            .filter(|e| is_skip(e))
+            .map(|e| (meth, e))
+    }) {
+        let _ = writeln!(
+            s,
+            "**`{}` was {why}** on this machine: its rows are empty.\n",
+            meth.label
+        );
     }
     for scene in &m.scenes {
         write_scene_table(&mut s, m, &scene.name, rows);
@@ -178,12 +203,48 @@ fn write_setting(s: &mut String, m: &Manifest, manifest: &Path, opts: &BenchOpti
         "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds as `--time-limit` (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
         m.methods[0].label
     );
+    write_external_notes(s, m);
+}
+
+/// The external methods' lines of the setting: each command, and how its seconds count.
+fn write_external_notes(s: &mut String, m: &Manifest) {
+    let external: Vec<&Method> = m.methods.iter().filter(|m| m.is_external()).collect();
+    if external.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "External methods render with acr, then run a command on the render; their seconds are the render's plus the command's (in brackets in the tables, column `command_seconds` of the CSV); at equal time the render's limit is the first method's seconds less the command's seconds in the method's own equal-spp run at that budget and seed:\n"
+    );
+    for meth in external {
+        let argv = meth.command.as_deref().unwrap_or_default().join(" ");
+        let counted = match meth.time.unwrap_or_default() {
+            super::CommandTime::Wall => "the wall time of its whole process",
+            super::CommandTime::Printed => "the seconds it prints on its last line",
+        };
+        let _ = writeln!(s, "- `{}`: `{argv}`; counted: {counted}", meth.label);
+    }
+    s.push('\n');
 }
 
 /// A scene's section: its plot, and a line per budget and method.
 fn write_scene_table(s: &mut String, m: &Manifest, scene: &str, rows: &[Row]) {
     let _ = writeln!(s, "## {scene}\n");
     let _ = writeln!(s, "![{0}]({0}.png)\n", file_safe(scene));
+    if let Some(&spp) = m.budgets.spp.iter().min() {
+        let mut modes = vec![Mode::EqualSpp];
+        if m.budgets.equal_time && m.methods.len() > 1 {
+            modes.push(Mode::EqualTime);
+        }
+        for mode in modes {
+            let name = format!("{}-images-{}-{spp}", file_safe(scene), mode.name());
+            let _ = writeln!(
+                s,
+                "Images at {spp} spp, {}: [side by side]({name}.png), [where they differ most]({name}-crop.png)\n",
+                mode.name()
+            );
+        }
+    }
     let _ = writeln!(
         s,
         "| spp | method | seconds | MSE | relMSE | MSE ratio | relMSE ratio | mean / reference | equal-time seconds | equal-time spp | equal-time MSE | MSE ratio | relMSE ratio |"
@@ -211,8 +272,8 @@ fn equal_spp_cells(line: &mut String, row: Option<&Row>, base: Option<&Measured>
         Some(Ok(r)) => {
             let _ = write!(
                 line,
-                "| {:.3} | {:.3e} | {:.3e} | {} | {} | {:.4} ",
-                r.seconds,
+                "| {} | {:.3e} | {:.3e} | {} | {} | {:.4} ",
+                seconds_cell(r),
                 r.metrics.mse,
                 r.metrics.relmse,
                 ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
@@ -220,6 +281,7 @@ fn equal_spp_cells(line: &mut String, row: Option<&Row>, base: Option<&Measured>
                 mean_ratio(&r.metrics)
             );
         }
+        Some(Err(e)) if is_skip(e) => line.push_str("| skipped | | | | | "),
         Some(Err(_)) => line.push_str("| failed | | | | | "),
         None => line.push_str("| | | | | | "),
     }
@@ -232,16 +294,25 @@ fn equal_time_cells(line: &mut String, row: Option<&Row>, base: Option<&Measured
         Some(Ok(r)) => {
             let _ = write!(
                 line,
-                "| {:.3} | {:.1} | {:.3e} | {} | {} |",
-                r.seconds,
+                "| {} | {:.1} | {:.3e} | {} | {} |",
+                seconds_cell(r),
                 r.spp_reached,
                 r.metrics.mse,
                 ratio(r.metrics.mse, base.map(|b| b.metrics.mse)),
                 ratio(r.metrics.relmse, base.map(|b| b.metrics.relmse))
             );
         }
+        Some(Err(e)) if is_skip(e) => line.push_str("| skipped | | | | |"),
         Some(Err(_)) => line.push_str("| failed | | | | |"),
         None => line.push_str("| | | | | |"),
+    }
+}
+
+/// A run's seconds, an external command's share in brackets.
+fn seconds_cell(r: &Measured) -> String {
+    match r.command_seconds {
+        Some(c) => format!("{:.3} ({c:.3})", r.seconds),
+        None => format!("{:.3}", r.seconds),
     }
 }
 
@@ -327,7 +398,7 @@ static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 
 /// Registers the embedded font with plotters once (its ab_glyph text needs one; no system
 /// font library is used).
-fn register_font() {
+pub(super) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         let _ =

@@ -1,7 +1,7 @@
 //! What a bench measures: a row per scene, method, budget and mode (means over its seeds), and
 //! the sampler-cost measures.
 
-use super::Mode;
+use super::{CommandTime, Mode};
 use crate::cli::stats::median;
 use crate::metrics::Metrics;
 
@@ -25,8 +25,13 @@ pub struct Row {
 /// What a successful run measured.
 #[derive(Clone, Debug)]
 pub struct Measured {
-    /// Render plus reconstruction time, from its stats file.
+    /// Render plus reconstruction time, from its stats file, plus an external method's
+    /// command's.
     pub seconds: f64,
+    /// An external method's command's share of `seconds`.
+    pub command_seconds: Option<f64>,
+    /// How that share was counted.
+    pub command_time: Option<CommandTime>,
     /// Samples taken.
     pub samples: u64,
     /// Samples per pixel reached.
@@ -86,6 +91,12 @@ impl Measured {
         let mean = |f: fn(&Measured) -> f64| runs.iter().map(f).sum::<f64>() / n;
         Ok(Measured {
             seconds: mean(|r| r.seconds),
+            command_seconds: runs
+                .iter()
+                .map(|r| r.command_seconds)
+                .sum::<Option<f64>>()
+                .map(|t| t / n),
+            command_time: runs.first().and_then(|r| r.command_time),
             samples: mean(|r| r.samples as f64).round() as u64,
             spp_reached: mean(|r| r.spp_reached),
             metrics: Metrics {

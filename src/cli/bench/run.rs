@@ -1,8 +1,10 @@
 //! The bench's run loop: every scene, budget and method, at equal spp and, after the first
 //! method, at equal time, each over the manifest's seeds.
 
-use super::budget::run_budget;
-use super::child::RenderRun;
+use super::budget::{run_budget, Spent};
+use super::child::{scored_path, RenderRun};
+use super::external::skip_reason;
+use super::gallery::write_gallery;
 use super::reference::reference_image;
 use super::report::write_results;
 use super::{
@@ -47,6 +49,8 @@ struct Bench<'a> {
     total: usize,
     /// Rows done so far.
     done: usize,
+    /// Per method, why its rows are skipped on this machine (an external program absent).
+    skipped: Vec<Option<String>>,
 }
 
 /// One method on one scene at one budget: what its rows share.
@@ -67,8 +71,8 @@ struct Cell<'a> {
 struct Times {
     /// The first method's, at this budget.
     baseline: Vec<Option<f64>>,
-    /// The method's own equal-spp run's.
-    own: Vec<Option<f64>>,
+    /// What the method's own equal-spp run spent.
+    own: Vec<Option<Spent>>,
 }
 
 impl<'a> Bench<'a> {
@@ -81,6 +85,19 @@ impl<'a> Bench<'a> {
                 } else {
                     0
                 });
+        let skipped: Vec<Option<String>> = m
+            .methods
+            .iter()
+            .map(|meth| skip_reason(meth, base))
+            .collect();
+        for (meth, why) in m.methods.iter().zip(&skipped) {
+            if let Some(why) = why {
+                eprintln!(
+                    "warning: method \"{}\" {why}: its rows are skipped",
+                    meth.label
+                );
+            }
+        }
         Bench {
             m,
             base,
@@ -89,6 +106,7 @@ impl<'a> Bench<'a> {
             seeds: m.run_seeds(),
             total: per_scene * m.scenes.len(),
             done: 0,
+            skipped,
         }
     }
 
@@ -111,6 +129,22 @@ impl<'a> Bench<'a> {
             };
             for (k, method) in m.methods.iter().enumerate() {
                 times.own = vec![None; self.seeds.len()];
+                if let Some(why) = &self.skipped[k] {
+                    let skip = |mode| Row {
+                        scene: scene.name.clone(),
+                        method: method.label.clone(),
+                        mode,
+                        spp,
+                        seeds: self.seeds.len(),
+                        outcome: Err(why.clone()),
+                    };
+                    rows.push(skip(Mode::EqualSpp));
+                    if k > 0 && m.budgets.equal_time {
+                        rows.push(skip(Mode::EqualTime));
+                    }
+                    self.done += if k > 0 && m.budgets.equal_time { 2 } else { 1 };
+                    continue;
+                }
                 let modes: &[Mode] = if k > 0 && m.budgets.equal_time {
                     &[Mode::EqualSpp, Mode::EqualTime]
                 } else {
@@ -126,6 +160,48 @@ impl<'a> Bench<'a> {
                 for &mode in modes {
                     rows.push(self.row(&cell, mode, &reference, &mut times));
                 }
+            }
+        }
+        if let Ok(reference) = &reference {
+            self.gallery(scene, reference);
+        }
+    }
+
+    /// The scene's images side by side, at the smallest budget, for each mode run.
+    fn gallery(&self, scene: &SceneEntry, reference: &RgbImage) {
+        let m = self.m;
+        let Some(&spp) = m.budgets.spp.iter().min() else {
+            return;
+        };
+        let modes: &[Mode] = if m.budgets.equal_time && m.methods.len() > 1 {
+            &[Mode::EqualSpp, Mode::EqualTime]
+        } else {
+            &[Mode::EqualSpp]
+        };
+        for &mode in modes {
+            let images: Vec<(String, PathBuf)> = m
+                .methods
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| self.skipped[*k].is_none())
+                .map(|(k, method)| {
+                    // The first method's equal-spp run is its equal-time run too.
+                    let mode = if k == 0 { Mode::EqualSpp } else { mode };
+                    let cell = Cell {
+                        scene,
+                        scene_path: Path::new(""),
+                        method,
+                        spp,
+                        first: k == 0,
+                    };
+                    let run = self.run_path(&cell, mode, self.seeds[0]);
+                    (method.label.clone(), scored_path(method, &run))
+                })
+                .collect();
+            let name = format!("{}-images-{}-{spp}", file_safe(&scene.name), mode.name());
+            let title = format!("{} at {spp} spp, {}", scene.name, mode.name());
+            if let Err(e) = write_gallery(&self.opts.out, &name, &title, reference, &images) {
+                eprintln!("{}: images side by side failed: {e}", scene.name);
             }
         }
     }
@@ -144,23 +220,35 @@ impl<'a> Bench<'a> {
         for (i, &seed) in self.seeds.iter().enumerate() {
             let out = self.run_path(cell, mode, seed);
             let outcome = reference.as_ref().map_err(Clone::clone).and_then(|r| {
-                let budget = (times.baseline[i], times.own[i]);
-                let (run_spp, limit) = run_budget(mode, cell.spp, &self.m.budgets, budget)?;
+                let (run_spp, limit) = run_budget(
+                    mode,
+                    cell.spp,
+                    &self.m.budgets,
+                    times.baseline[i],
+                    times.own[i],
+                    cell.method.is_external(),
+                )?;
                 let run = RenderRun {
                     exe: &self.opts.exe,
                     scene: cell.scene_path,
                     method: cell.method,
                     seed,
                     threads: self.m.threads,
+                    pixelbounds: cell.scene.pixelbounds,
                 };
-                run.measure(&out, run_spp, limit, r)
+                run.measure(&out, run_spp, limit, r, self.base)
             });
-            let seconds = outcome.as_ref().ok().map(|r| r.seconds);
             if cell.first {
-                times.baseline[i] = seconds;
+                times.baseline[i] = outcome.as_ref().ok().map(|r| r.seconds);
             }
             if mode == Mode::EqualSpp {
-                times.own[i] = seconds;
+                times.own[i] = outcome.as_ref().ok().map(|r| {
+                    let command = r.command_seconds.unwrap_or(0.0);
+                    Spent {
+                        render: r.seconds - command,
+                        command,
+                    }
+                });
             }
             runs.push(outcome);
         }
