@@ -294,8 +294,8 @@ fn bench_runs_an_external_command_as_a_method_and_skips_one_whose_program_is_abs
     let dir = TempDir::new("bench-external");
     dir.write("s.pbrt", &small_scene(""));
     // `cp` through sh: the command's image is the render itself, so its MSE is the plain
-    // method's; it prints 0.01 as its seconds.
-    let copy = "command = [\"sh\", \"-c\", \"cp \\\"$0\\\" \\\"$1\\\" && echo 0.01\", \"{in}\", \"{out}\"]";
+    // method's; it prints 1 µs as its seconds (less than any render here, so that its equal-time render has time left).
+    let copy = "command = [\"sh\", \"-c\", \"cp \\\"$0\\\" \\\"$1\\\" && echo 0.000001\", \"{in}\", \"{out}\"]";
     let manifest = dir.write(
         "m.toml",
         &format!(
@@ -334,14 +334,14 @@ fn bench_runs_an_external_command_as_a_method_and_skips_one_whose_program_is_abs
     assert_eq!(copied[7], plain[7], "MSE: {csv}");
     assert_eq!(
         (copied[14].as_str(), copied[15].as_str()),
-        ("0.010000", "printed")
+        ("0.000001", "printed")
     );
     assert!(plain[14].is_empty() && plain[15].is_empty(), "{csv}");
     // The crop: 16 x 12 pixels.
     assert_eq!(copied[5], (2 * 16 * 12).to_string(), "{csv}");
     let timed = row("copy", "equal-time");
     assert_eq!(timed[11], "ok", "{csv}");
-    assert_eq!(timed[14], "0.010000", "{csv}");
+    assert_eq!(timed[14], "0.000001", "{csv}");
     for mode in ["equal-spp", "equal-time"] {
         let absent = row("absent", mode);
         assert!(absent[11].starts_with("\"skipped: program"), "{csv}");
