@@ -55,9 +55,11 @@ pub(super) fn run_command(
     let (program, args) = argv
         .split_first()
         .ok_or_else(|| format!("method \"{label}\": empty command"))?;
-    let program_path = find_program(program, base)
-        .ok_or_else(|| format!("method \"{label}\": program \"{program}\" not found"))?;
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_owned());
+    // Absolute, since a relative program path would be taken from the child's folder.
+    let program_path = find_program(program, base)
+        .map(|p| absolute(&p))
+        .ok_or_else(|| format!("method \"{label}\": program \"{program}\" not found"))?;
     let (input, output) = (absolute(input), absolute(output));
     let _ = std::fs::remove_file(&output);
     let mut cmd = Command::new(&program_path);
@@ -132,6 +134,7 @@ mod tests {
         assert!(printed_seconds("NaN\n").is_err());
     }
 
+    #[cfg(unix)]
     #[test]
     fn commands_run_in_the_manifest_s_folder_and_their_failures_name_the_method() {
         let dir = std::env::temp_dir().join(format!("acr-bench-external-{}", std::process::id()));
@@ -199,6 +202,19 @@ mod tests {
             let e = run_command(&absent, &dir, &input, &output).unwrap_err();
             assert!(e.contains("not found") && e.contains("\"den\""), "{e}");
         }
+        // A program relative to a manifest's folder that is itself relative to ours.
+        let script = dir.join("sub/tools/copy.sh");
+        std::fs::create_dir_all(script.parent().unwrap()).unwrap();
+        std::fs::write(&script, "#!/bin/sh\ncp \"$1\" \"$2\"\n").unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&script, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let cwd = std::env::current_dir().unwrap();
+        let up: PathBuf = cwd.components().skip(1).map(|_| "..").collect();
+        let relative = up.join(dir.join("sub").strip_prefix("/").unwrap());
+        let tool = method(&["./tools/copy.sh", "{in}", "{out}"], None);
+        assert_eq!(skip_reason(&tool, &relative), None);
+        run_command(&tool, &relative, &input, &output).unwrap();
+        assert_eq!(std::fs::read(&output).unwrap(), b"image");
         assert_eq!(skip_reason(&copy, &dir), None);
         assert_eq!(skip_reason(&Method::default(), &dir), None);
         let _ = std::fs::remove_dir_all(&dir);
