@@ -187,14 +187,7 @@ impl<'a> Bench<'a> {
                 .map(|(k, method)| {
                     // The first method's equal-spp run is its equal-time run too.
                     let mode = if k == 0 { Mode::EqualSpp } else { mode };
-                    let cell = Cell {
-                        scene,
-                        scene_path: Path::new(""),
-                        method,
-                        spp,
-                        first: k == 0,
-                    };
-                    let run = self.run_path(&cell, mode, self.seeds[0]);
+                    let run = self.run_path((scene, method, spp), mode, self.seeds[0]);
                     (method.label.clone(), scored_path(method, &run))
                 })
                 .collect();
@@ -218,7 +211,7 @@ impl<'a> Bench<'a> {
         self.done += 1;
         let mut runs = Vec::with_capacity(self.seeds.len());
         for (i, &seed) in self.seeds.iter().enumerate() {
-            let out = self.run_path(cell, mode, seed);
+            let out = self.run_path((cell.scene, cell.method, cell.spp), mode, seed);
             let outcome = reference.as_ref().map_err(Clone::clone).and_then(|r| {
                 let (run_spp, limit) = run_budget(
                     mode,
@@ -264,8 +257,13 @@ impl<'a> Bench<'a> {
         }
     }
 
-    /// The image of `cell`'s run in `mode` with `seed`.
-    fn run_path(&self, cell: &Cell, mode: Mode, seed: u64) -> PathBuf {
+    /// The image of the run of a scene, method and budget in `mode` with `seed`.
+    fn run_path(
+        &self,
+        (scene, method, spp): (&SceneEntry, &Method, u32),
+        mode: Mode,
+        seed: u64,
+    ) -> PathBuf {
         // One seed keeps the file names of before.
         let tag = if self.seeds.len() > 1 {
             format!("-seed{seed}")
@@ -274,9 +272,9 @@ impl<'a> Bench<'a> {
         };
         self.runs_dir.join(format!(
             "{}-{}-{}-{}{tag}.exr",
-            file_safe(&cell.scene.name),
-            file_safe(&cell.method.label),
-            cell.spp,
+            file_safe(&scene.name),
+            file_safe(&method.label),
+            spp,
             mode.name()
         ))
     }
