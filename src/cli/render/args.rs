@@ -1,5 +1,6 @@
 //! The command line of `acr render`: its arguments and their parsers.
 
+use super::pipeline::Pipeline;
 use crate::cli::{parse_seconds, parse_threshold};
 use crate::render::MAX_SPP;
 use std::path::PathBuf;
@@ -45,6 +46,13 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", default_value_t = 4, requires = "noise_threshold",
           value_parser = clap::value_parser!(u32).range(2..=MAX_SPP as i64))]
     pub min_spp: u32,
+    /// Whose sampler and filter render: `scene`, the scene's Sampler and PixelFilter as
+    /// --sampler and --filter override them; `auto`, the pipeline measured best at equal time
+    /// for the scene's dimensions (motion blur, lens), said on stderr and in the stats. Default:
+    /// `auto` when --time-limit or --noise-threshold is given and neither the command line nor
+    /// the scene names a sampler or filter (nor --mergeable or --sample-offset), else `scene`.
+    #[arg(long, value_enum)]
+    pub pipeline: Option<Pipeline>,
     /// The sampler, by name (overrides the scene's Sampler; see `acr plugins`).
     #[arg(long)]
     pub sampler: Option<String>,
