@@ -1,6 +1,5 @@
 //! The command line of `acr render`: its arguments and their parsers.
 
-use super::pipeline::Pipeline;
 use crate::cli::{parse_seconds, parse_threshold};
 use crate::render::MAX_SPP;
 use std::path::PathBuf;
@@ -13,6 +12,15 @@ pub enum TimePlan {
     Fit,
     /// Its budget (`--spp`), as without a limit.
     Budget,
+}
+
+/// `--pipeline`: whose sampler and filter render.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipeline {
+    /// The scene's Sampler and PixelFilter, as the command line overrides them.
+    Scene,
+    /// The pipeline measured best at equal time for the scene's dimensions (docs/cli.md).
+    Auto,
 }
 
 /// Arguments of `acr render`.

@@ -13,8 +13,8 @@ mod run;
 mod sampler_cost;
 mod target;
 
-pub use args::{RenderArgs, TimePlan};
-pub use pipeline::{row_for, Pipeline, Row, TABLE};
+pub use args::{Pipeline, RenderArgs, TimePlan};
+pub use pipeline::{row_for, Row, TABLE};
 
 use prepare::Job;
 use run::Rendered;

@@ -4,18 +4,9 @@
 //! row the pipeline measured best at equal time on the bench scenes of that kind
 //! (docs/BENCHMARKS.md). Changing the choice is changing a row of [`TABLE`].
 
-use super::RenderArgs;
+use super::args::{Pipeline, RenderArgs};
 use acr_parser::SceneDescription;
 use acr_plugins::Dims;
-
-/// `--pipeline`: whose sampler and filter render.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Pipeline {
-    /// The scene's Sampler and PixelFilter, as the command line overrides them.
-    Scene,
-    /// The pipeline measured best at equal time for the scene's dimensions (docs/cli.md).
-    Auto,
-}
 
 /// One row of the table: the scene's dimensions it serves and the pipeline it renders with.
 #[derive(Debug, PartialEq, Eq)]
