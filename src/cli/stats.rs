@@ -54,6 +54,10 @@ pub struct Stats {
     pub filter: String,
     /// Integrator name.
     pub integrator: String,
+    /// Who chose the sampler and filter: "scene" (the scene and the command line), or
+    /// "auto:SAMPLER+FILTER" (`--pipeline auto`, or a time limit or noise threshold with
+    /// neither named; docs/cli.md).
+    pub pipeline: String,
     /// Active dimensions of the rendering space, e.g. ["x","y","t"].
     pub dims: Vec<String>,
     /// The time limit or the noise threshold stopped the render before its budget was spent.

@@ -4,6 +4,7 @@
 mod aovs;
 mod errors;
 mod output;
+mod pipeline;
 mod plugins;
 mod stopping;
 mod tools;

@@ -29,6 +29,10 @@ pub struct Gem {
     /// A coarser scale is accepted while its squared change is at most this times the sum of
     /// the two scales' variances.
     gamma: f64,
+    /// The image through symmetric weights made from the pixels' chosen scales instead of
+    /// each pixel gathering at its own, so that the image mean is the mean of the pixel
+    /// means whatever the scales (`unbiased`; docs/rivals.md).
+    symmetric: bool,
 }
 
 /// One pixel's filtered value at one scale and that value's variance.
@@ -107,7 +111,7 @@ impl Gem {
     /// scale's luminance (what the relative error is taken against: a pixel's own noisy value
     /// would send more samples to pixels whose first samples happened to be dark, and so bias
     /// the image up; measured +2.2% mean on motion-blur at 8 spp).
-    fn select(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<([f64; 3], f64, f64)> {
+    fn select(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<Selected> {
         let var = m.vars_of_mean();
         let bank: Vec<Vec<Filtered>> = (0..self.scales)
             .map(|k| self.filter(space, m, &var, k))
@@ -128,11 +132,118 @@ impl Gem {
                     k += 1;
                 }
                 let f = &bank[k][i];
-                let coarse = lum(&bank[bank.len() - 1][i].value);
-                (f.value, f.var + bias2, coarse)
+                Selected {
+                    scale: k,
+                    value: f.value,
+                    error: f.var + bias2,
+                    coarse: lum(&bank[bank.len() - 1][i].value),
+                }
             })
             .collect()
     }
+
+    /// The image through symmetric weights: between pixels i and j, the smaller of i's
+    /// weight on j and j's weight on i at their chosen scales (each a Gaussian truncated at 3
+    /// std, normalised over the taps inside the image); each pixel keeps the rest of its unit
+    /// weight for itself. Rows and columns then both sum to 1: a flat region stays flat and
+    /// the image sums to the sum of the pixel means whatever the scales. Gathered each at its
+    /// own scale, a pixel whose samples scatter widely (a firefly) picks a coarse scale and
+    /// its value is replaced by its neighbours', its excess lost, which darkens the image
+    /// where the rare outcome is the bright one (measured: docs/rivals.md).
+    fn symmetric(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<[f64; 3]> {
+        let (w, h) = (space.width() as usize, space.height() as usize);
+        let scales: Vec<usize> = self.select(space, m).iter().map(|s| s.scale).collect();
+        let bank: Vec<Taps> = (0..self.scales)
+            .map(|k| Taps::new(self.sigma0 * 2f64.sqrt().powi(k as i32), w, h))
+            .collect();
+        let mut out = vec![[0.0f64; 3]; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let ti = &bank[scales[i]];
+                let mut own = 1.0;
+                let mut acc = [0.0f64; 3];
+                let r = ti.r as usize;
+                for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
+                    for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
+                        let j = yy * w + xx;
+                        if j == i {
+                            continue;
+                        }
+                        let tj = &bank[scales[j]];
+                        let wt = ti.weight(x, y, xx, yy).min(tj.weight(xx, yy, x, y));
+                        if wt > 0.0 {
+                            own -= wt;
+                            let mean = m.mean(j);
+                            for c in 0..3 {
+                                acc[c] += wt * mean[c];
+                            }
+                        }
+                    }
+                }
+                let mean = m.mean(i);
+                for c in 0..3 {
+                    out[i][c] = acc[c] + own * mean[c];
+                }
+            }
+        }
+        out
+    }
+}
+
+/// One scale's Gaussian, truncated at 3 std, with each row's and column's sum over the taps
+/// that land inside the image (its weights normalised there).
+struct Taps {
+    r: i64,
+    kernel: Vec<f64>,
+    /// Sum of the taps inside [0, w) around each column.
+    col: Vec<f64>,
+    /// Sum of the taps inside [0, h) around each row.
+    row: Vec<f64>,
+}
+
+impl Taps {
+    fn new(sigma: f64, w: usize, h: usize) -> Self {
+        let r = (3.0 * sigma).ceil() as i64;
+        let kernel: Vec<f64> = (-r..=r)
+            .map(|d| (-(d * d) as f64 / (2.0 * sigma * sigma)).exp())
+            .collect();
+        let sums = |n: usize| -> Vec<f64> {
+            (0..n as i64)
+                .map(|at| {
+                    let (lo, hi) = ((at - r).max(0), (at + r).min(n as i64 - 1));
+                    (lo..=hi).map(|t| kernel[(t - at + r) as usize]).sum()
+                })
+                .collect()
+        };
+        let (col, row) = (sums(w), sums(h));
+        Self {
+            r,
+            kernel,
+            col,
+            row,
+        }
+    }
+
+    /// The weight of pixel (x, y)'s gather on pixel (xx, yy): 0 beyond the truncation.
+    fn weight(&self, x: usize, y: usize, xx: usize, yy: usize) -> f64 {
+        let (dx, dy) = (xx as i64 - x as i64, yy as i64 - y as i64);
+        if dx.abs() > self.r || dy.abs() > self.r {
+            return 0.0;
+        }
+        let kx = self.kernel[(dx + self.r) as usize] / self.col[x];
+        let ky = self.kernel[(dy + self.r) as usize] / self.row[y];
+        kx * ky
+    }
+}
+
+/// One pixel's choice: its scale, the value and estimated squared error there, and the
+/// coarsest scale's luminance.
+struct Selected {
+    scale: usize,
+    value: [f64; 3],
+    error: f64,
+    coarse: f64,
 }
 
 impl PixelMethod for Gem {
@@ -141,9 +252,9 @@ impl PixelMethod for Gem {
     fn error(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<f64> {
         self.select(space, m)
             .into_iter()
-            .map(|(_, err, y)| {
+            .map(|s| {
                 // Relative error; the floor keeps black pixels from claiming everything.
-                let e = err / (y * y + 1e-3);
+                let e = s.error / (s.coarse * s.coarse + 1e-3);
                 if e.is_finite() {
                     e
                 } else {
@@ -154,9 +265,16 @@ impl PixelMethod for Gem {
     }
 
     fn reconstruct(&self, space: &RenderingSpace, m: &PixelMoments) -> Vec<Spectrum> {
+        if self.symmetric {
+            return self
+                .symmetric(space, m)
+                .into_iter()
+                .map(super::nonnegative_spectrum)
+                .collect();
+        }
         self.select(space, m)
             .into_iter()
-            .map(|(v, _, _)| super::nonnegative_spectrum(v))
+            .map(|s| super::nonnegative_spectrum(s.value))
             .collect()
     }
 }
@@ -167,6 +285,7 @@ fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn super::Sampler>> {
         scales: int_in(p, "scales", 5, 1..=12)?,
         sigma0: float_in(p, "sigma0", 0.5, 0.1..=8.0)?,
         gamma: float_in(p, "gamma", 1.0, 0.0..=1e6)?,
+        symmetric: p.bool_or("unbiased", false)?,
     };
     pixel_rounds::build(method, p, setup, SALT)
 }

@@ -49,15 +49,16 @@ pub(crate) const PILOT: ParamSpec = ParamSpec::new(
      docs/cluster-sampler.md",
 );
 
-/// The `pilot` parameter of mdas, which has no `unbiased`: its way to an unbiased mean.
+/// The `pilot` parameter of mdas, which has no `unbiased`: its way out of selection bias.
 pub(crate) const PILOT_ONLY: ParamSpec = ParamSpec::new(
     "pilot",
     ParamType::Float,
     "0",
     "share of the budget traced first as a value-blind pilot stream that alone decides where \
-     the rest goes; the image blends the two with fixed weights, so the mean is unbiased \
-     (0: off, decisions read every value, as the method was published). mdas's only way to \
-     an unbiased mean (pilot 0.25 measured 0.6x to 6x the published MSE); see docs/rivals.md",
+     the rest goes; the image blends the two with fixed weights, so no value decides its own \
+     pixel's weight (0: off, decisions read every value, as the method was published). \
+     mdas's way out of selection bias (pilot 0.25 measured 0.6x to 6x the published MSE); \
+     its leaves' means still shift the image (-0.7% on the Cornell box); see docs/rivals.md",
 );
 
 /// Per-pixel count parameters that each stream takes half of.

@@ -283,7 +283,10 @@ pub(crate) const ROUND_PARAMS: [ParamSpec; 4] = [
         ParamType::Bool,
         "false",
         "decide each pixel's count from the other colour of a checkerboard, from the first \
-         round alone (one adaptive round), so that no pixel's count reads its own values",
+         round alone (one adaptive round), so that no pixel's count reads its own values, and \
+         reconstruct so that the image sums to the sum of the pixel means (gem: symmetric \
+         weights from the chosen scales; awr: blocks across the image's edge kept whole): an \
+         unbiased image mean (docs/rivals.md)",
     ),
 ];
 

@@ -14,6 +14,15 @@ pub enum TimePlan {
     Budget,
 }
 
+/// `--pipeline`: whose sampler and filter render.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipeline {
+    /// The scene's Sampler and PixelFilter, as the command line overrides them.
+    Scene,
+    /// The pipeline measured best at equal time for the scene's dimensions (docs/cli.md).
+    Auto,
+}
+
 /// Arguments of `acr render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
@@ -45,6 +54,13 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", default_value_t = 4, requires = "noise_threshold",
           value_parser = clap::value_parser!(u32).range(2..=MAX_SPP as i64))]
     pub min_spp: u32,
+    /// Whose sampler and filter render: `scene`, the scene's Sampler and PixelFilter as
+    /// --sampler and --filter override them; `auto`, the pipeline measured best at equal time
+    /// for the scene's dimensions (motion blur, lens), said on stderr and in the stats. Default:
+    /// `auto` when --time-limit or --noise-threshold is given and neither the command line nor
+    /// the scene names a sampler or filter (nor --mergeable or --sample-offset), else `scene`.
+    #[arg(long, value_enum)]
+    pub pipeline: Option<Pipeline>,
     /// The sampler, by name (overrides the scene's Sampler; see `acr plugins`).
     #[arg(long)]
     pub sampler: Option<String>,

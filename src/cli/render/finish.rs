@@ -80,6 +80,7 @@ pub(super) fn stats(
         sampler: plugins.sampler.name().into(),
         filter: plugins.reconstruction().into(),
         integrator: plugins.integrator.name().into(),
+        pipeline: super::pipeline::stats_name(job.pipeline),
         halted: counts.halted,
         halted_by: counts.halted_by.map(Halt::name),
         dims: job

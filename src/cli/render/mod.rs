@@ -1,18 +1,20 @@
 //! `acr render`: a scene to an image, with AOVs, statistics and the sampler-cost measure. The
 //! command is a sequence of named steps, one file each: prepare the scene and its plugins
-//! (`prepare.rs`), plan the output files (`target.rs`), render (`run.rs`), measure the
+//! (`prepare.rs`, with `--pipeline`'s choice in `pipeline.rs`), plan the output files (`target.rs`), render (`run.rs`), measure the
 //! sampler's cost (`sampler_cost.rs`), write the image, the AOVs and the stats (`finish.rs`).
 
 use std::time::Instant;
 
 mod args;
 mod finish;
+mod pipeline;
 mod prepare;
 mod run;
 mod sampler_cost;
 mod target;
 
-pub use args::{RenderArgs, TimePlan};
+pub use args::{Pipeline, RenderArgs, TimePlan};
+pub use pipeline::{row_for, Row, TABLE};
 
 use prepare::Job;
 use run::Rendered;

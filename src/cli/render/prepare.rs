@@ -1,6 +1,7 @@
 //! The steps before the render: the worker threads started, the scene read and built, its
 //! plugins chosen and checked against the flags, the warnings printed.
 
+use super::pipeline::{self, Row};
 use super::RenderArgs;
 use crate::registry::{choose_for_scene, Overrides, Plugins};
 use crate::scene::Scene;
@@ -33,8 +34,10 @@ pub(super) struct Job {
     pub(super) desc: SceneDescription,
     /// The scene built.
     pub(super) scene: Scene,
-    /// The command line's choices of plugins and their parameters.
+    /// The command line's choices of plugins and their parameters (with an auto pipeline's).
     pub(super) overrides: Overrides,
+    /// The auto pipeline's row, when it chose the sampler and filter.
+    pub(super) pipeline: Option<&'static Row>,
     /// The sampler, filter and integrator.
     pub(super) plugins: Plugins,
     /// Whether the film splats each sample with the filter's kernel (neither the filter's
@@ -49,7 +52,8 @@ impl Job {
         let spp = if args.quick { Some(1) } else { args.spp };
         let mut warnings = desc.warnings.clone();
         let scene = build_scene(args, &desc, &mut warnings)?;
-        let overrides = overrides(args)?;
+        let auto = pipeline::choose(args, &desc, scene.dims)?;
+        let overrides = overrides(args, auto)?;
         let mut plugins =
             choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
                 .map_err(|e| e.to_string())?;
@@ -64,10 +68,14 @@ impl Job {
             ));
         }
         print_warnings(&desc, warnings);
+        if let Some(row) = auto {
+            eprintln!("{}", pipeline::announce(row));
+        }
         Ok(Job {
             desc,
             scene,
             overrides,
+            pipeline: auto,
             plugins,
             splats,
         })
@@ -101,16 +109,20 @@ fn build_scene(
     Ok(scene)
 }
 
-/// The plugins and parameters the command line names.
-fn overrides(args: &RenderArgs) -> Result<Overrides, String> {
+/// The plugins and parameters the command line names, or the auto pipeline's `row` with the
+/// command line's `--set`s after its own.
+fn overrides(args: &RenderArgs, row: Option<&Row>) -> Result<Overrides, String> {
+    let named = |r: Option<&Row>, name: fn(&Row) -> &'static str, given: &Option<String>| {
+        r.map(|r| name(r).to_owned()).or_else(|| given.clone())
+    };
+    let row_settings = row.map_or(&[][..], |r| r.settings).iter().copied();
     Ok(Overrides {
-        sampler: args.sampler.clone(),
-        filter: args.filter.clone(),
+        sampler: named(row, |r| r.sampler, &args.sampler),
+        filter: named(row, |r| r.filter, &args.filter),
         integrator: args.integrator.clone(),
-        settings: args
-            .set
-            .iter()
-            .map(|s| Setting::parse(s))
+        settings: row_settings
+            .chain(args.set.iter().map(String::as_str))
+            .map(Setting::parse)
             .collect::<Result<_, _>>()
             .map_err(|e| e.to_string())?,
     })

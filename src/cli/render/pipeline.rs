@@ -1,0 +1,162 @@
+//! `--pipeline`: the sampler and filter a render uses when the user asks for the best image in
+//! a time (or to a noise threshold) and names neither. The choice is a table keyed on what is
+//! known before rendering, the scene's dimensions (motion blur, a lens, both, neither), each
+//! row the pipeline measured best at equal time on the bench scenes of that kind
+//! (docs/BENCHMARKS.md). Changing the choice is changing a row of [`TABLE`].
+
+use super::args::{Pipeline, RenderArgs};
+use acr_parser::SceneDescription;
+use acr_plugins::Dims;
+
+/// One row of the table: the scene's dimensions it serves and the pipeline it renders with.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Row {
+    /// Something moves during the shutter (the time dim).
+    pub time: bool,
+    /// The camera has a lens (the lens dims).
+    pub lens: bool,
+    /// The sampler, by name.
+    pub sampler: &'static str,
+    /// The filter, by name.
+    pub filter: &'static str,
+    /// Parameters, as `--set` takes them, applied before the command line's `--set`s.
+    pub settings: &'static [&'static str],
+    /// The measurement behind the row.
+    pub measured: &'static str,
+}
+
+/// The samples per pixel an auto pipeline is capped at without `--spp`: the cap the equal-time
+/// benches measured with (their `time_limited_spp`). A scene without a Sampler would otherwise
+/// stop at pbrt-v3's default 16 whatever the time.
+const SPP_CAP: &str = "sampler.pixelsamples=64";
+
+/// The pipelines, by the scene's dimensions. Every row: `bench/sobol_polynomial.toml`, three
+/// seeds, MSE at the times stratified+gaussian takes at 8, 16 and 32 spp.
+pub const TABLE: [Row; 4] = [
+    Row {
+        time: false,
+        lens: false,
+        sampler: "cluster",
+        filter: "polynomial",
+        settings: &[SPP_CAP],
+        measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
+                   time\": cornell-box-gi 0.046x / 0.015x / 0.0062x of stratified+gaussian \
+                   against sobol+polynomial's 0.10x / 0.051x / 0.014x; indirect-room-gi 0.11x / \
+                   0.15x / 0.21x against 0.11x / 0.15x / 0.23x",
+    },
+    Row {
+        time: true,
+        lens: false,
+        sampler: "sobol",
+        filter: "polynomial",
+        settings: &[SPP_CAP],
+        measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
+                   time\": motion-blur-3d 0.32x / 0.25x / 0.19x of stratified+gaussian against \
+                   cluster+polynomial's 0.42x / 0.23x / 0.21x",
+    },
+    Row {
+        time: false,
+        lens: true,
+        sampler: "sobol",
+        filter: "polynomial",
+        settings: &[SPP_CAP],
+        measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
+                   time\": depth-of-field-4d 0.64x / 0.56x / 0.59x of stratified+gaussian \
+                   against cluster+polynomial's 0.65x / 0.62x / 0.57x",
+    },
+    Row {
+        time: true,
+        lens: true,
+        sampler: "sobol",
+        filter: "polynomial",
+        settings: &[SPP_CAP],
+        measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
+                   time\": motion-dof-5d 0.61x / 0.64x / 0.70x of stratified+gaussian against \
+                   cluster+polynomial's 0.74x / 0.69x / 0.79x",
+    },
+];
+
+/// The row for a scene of dimensions `dims`.
+pub fn row_for(dims: Dims) -> &'static Row {
+    TABLE
+        .iter()
+        .find(|r| r.time == dims.time && r.lens == dims.lens)
+        .expect("the table has a row for every combination of time and lens")
+}
+
+/// The row the render uses, or `None` for the scene's pipeline: `--pipeline auto`, or, without
+/// `--pipeline`, a render stopped by `--time-limit` or `--noise-threshold` that names no
+/// sampler or filter on the command line or in the scene (and asks for nothing only some
+/// samplers and filters give: `--mergeable`, `--sample-offset`).
+pub(super) fn choose(
+    args: &RenderArgs,
+    desc: &SceneDescription,
+    dims: Dims,
+) -> Result<Option<&'static Row>, String> {
+    let named_here = args.sampler.is_some() || args.filter.is_some();
+    match args.pipeline {
+        Some(Pipeline::Scene) => Ok(None),
+        Some(Pipeline::Auto) if named_here => Err("--pipeline auto chooses the sampler and \
+                                                   filter: drop --sampler and --filter, or \
+                                                   --pipeline auto"
+            .to_owned()),
+        Some(Pipeline::Auto) => Ok(Some(row_for(dims))),
+        None => {
+            let stopped = args.time_limit.is_some() || args.noise_threshold.is_some();
+            let named = named_here || desc.sampler.is_some() || desc.filter.is_some();
+            let needs_scene = args.mergeable || args.sample_offset > 0;
+            Ok((stopped && !named && !needs_scene).then(|| row_for(dims)))
+        }
+    }
+}
+
+/// The stats file's `pipeline`: "scene", or "auto:SAMPLER+FILTER".
+pub(super) fn stats_name(row: Option<&Row>) -> String {
+    match row {
+        None => "scene".to_owned(),
+        Some(r) => format!("auto:{}+{}", r.sampler, r.filter),
+    }
+}
+
+/// What stderr says of an auto pipeline: the row and where its measurement is.
+pub(super) fn announce(row: &Row) -> String {
+    let dims = match (row.time, row.lens) {
+        (false, false) => "no motion blur, no lens",
+        (true, false) => "motion blur",
+        (false, true) => "a lens",
+        (true, true) => "motion blur and a lens",
+    };
+    let source = row.measured.split(':').next().unwrap_or(row.measured);
+    format!(
+        "acr: pipeline auto: {} + {} for a scene with {dims}, measured best at equal time \
+         ({source}); --pipeline scene renders with the scene's sampler and filter",
+        row.sampler, row.filter
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_combination_of_dims_has_one_row_of_known_plugins() {
+        for time in [false, true] {
+            for lens in [false, true] {
+                let n = TABLE
+                    .iter()
+                    .filter(|r| r.time == time && r.lens == lens)
+                    .count();
+                assert_eq!(n, 1, "time {time}, lens {lens}");
+            }
+        }
+        let names: Vec<&str> = crate::registry::all().map(|i| i.name).collect();
+        for r in &TABLE {
+            assert!(names.contains(&r.sampler), "{}", r.sampler);
+            assert!(names.contains(&r.filter), "{}", r.filter);
+            assert!(r.measured.contains("docs/BENCHMARKS.md"), "{}", r.measured);
+            for s in r.settings {
+                acr_plugins::Setting::parse(s).unwrap();
+            }
+        }
+    }
+}
