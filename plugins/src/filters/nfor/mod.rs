@@ -1,0 +1,221 @@
+//! `nfor`: nonlinearly weighted first-order regression (Bitterli et al. 2016), the design
+//! docs/reconstruction.md describes. The film keeps two halves of each pixel's samples (by
+//! index parity) with their first-hit features; the features are prefiltered by NL-means
+//! across the halves; each half's colour is regressed on the features in a window, weighted
+//! by NL-means on the other half's colour, at several bandwidths; the unfiltered mean and the
+//! fits are candidates, and each pixel takes the one whose MSE, estimated from the halves,
+//! is lowest, the choice smoothed.
+
+mod nlmeans;
+mod planes;
+mod regression;
+mod selection;
+
+use super::{BoxFilter, Filter, FilterBuild, FilterKernel, SamplerOutput};
+use crate::film::{Film, PixelBuffers, Spectrum};
+use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
+use acr_parser::{ParamType, Result};
+use nlmeans::{nl_means, Guide};
+use planes::{Inputs, Planes};
+use regression::Regression;
+use selection::{candidate_mse, select, Candidate, Smoothing};
+
+/// The regression window's radius by default.
+pub const RADIUS: u32 = 5;
+/// The NL-means patch radius by default (NFOR's and Tungsten's).
+pub const PATCH: u32 = 3;
+/// The feature prefilter's window radius by default.
+pub const PREFILTER_RADIUS: u32 = 3;
+/// The radius of the window that smooths the MSE estimates and the choice.
+pub const SELECT_RADIUS: u32 = 3;
+/// The ridge on the slopes, relative to the weights' sum.
+pub const RIDGE: f64 = 1e-3;
+/// The NL-means bandwidths of the regression's candidates (NFOR's).
+const BANDWIDTHS: [f32; 2] = [0.5, 1.0];
+/// The feature prefilter's bandwidth (NFOR's).
+const PREFILTER_K: f32 = 0.5;
+
+/// The NFOR reconstruction.
+#[derive(Debug)]
+pub struct NforFilter {
+    radius: usize,
+    patch: usize,
+    prefilter_radius: usize,
+    select_radius: usize,
+    ridge: f32,
+    /// The film keeps pixel statistics only: a box of one pixel.
+    kernel: BoxFilter,
+}
+
+impl Default for NforFilter {
+    fn default() -> Self {
+        Self::new(RADIUS, PATCH, PREFILTER_RADIUS, SELECT_RADIUS, RIDGE)
+    }
+}
+
+impl NforFilter {
+    /// The filter with its windows' radii and ridge.
+    pub fn new(radius: u32, patch: u32, prefilter: u32, select: u32, ridge: f64) -> Self {
+        Self {
+            radius: radius as usize,
+            patch: patch as usize,
+            prefilter_radius: prefilter as usize,
+            select_radius: select as usize,
+            ridge: ridge as f32,
+            kernel: BoxFilter::new(0.5, 0.5),
+        }
+    }
+
+    /// The filtered image and its estimated per-pixel MSE, with the bandwidths `ks`.
+    fn denoise(&self, b: &PixelBuffers, ks: &[f32]) -> (Planes, Vec<f32>) {
+        let inp = Inputs::read(b);
+        let hit = &inp.hit;
+        // Features prefiltered across the halves: each half's features averaged with
+        // weights from the other half's.
+        let prefiltered = [0, 1].map(|h| {
+            let guide = Guide {
+                image: &inp.features[1 - h],
+                variance: &inp.features_var,
+                patch: self.patch,
+                k2: PREFILTER_K * PREFILTER_K,
+            };
+            nl_means(&inp.features[h], guide, self.prefilter_radius, hit)
+        });
+        // Each half fitted on the other half's prefiltered features with weights from the
+        // other half's colour (Tungsten's crossing).
+        let fits = [0, 1].map(|h| {
+            let reg = Regression {
+                color: &inp.color[h],
+                features: &prefiltered[1 - h],
+                hit,
+                radius: self.radius,
+                ridge: self.ridge,
+            };
+            let guide = Guide {
+                image: &inp.color[1 - h],
+                variance: &inp.color_var,
+                patch: self.patch,
+                k2: 1.0,
+            };
+            reg.run(guide, ks)
+        });
+        let [fa, fb] = fits;
+        let mut candidates = vec![Candidate {
+            halves: inp.color.clone(),
+        }];
+        for (a, b) in fa.into_iter().zip(fb) {
+            candidates.push(Candidate { halves: [a, b] });
+        }
+        let mut mses = vec![(0..inp.full_var.w * inp.full_var.h)
+            .map(|i| inp.full_var.px(i).iter().sum::<f32>() / 3.0)
+            .collect::<Vec<f32>>()];
+        for c in &candidates[1..] {
+            mses.push(candidate_mse(c, &inp.color, &inp.color_var));
+        }
+        let smoothing = Smoothing {
+            guide: Guide {
+                image: &inp.full,
+                variance: &inp.full_var,
+                patch: 1,
+                k2: 1.0,
+            },
+            radius: self.select_radius,
+            hit,
+        };
+        let ([ra, rb], mse) = select(&candidates, &mses, &smoothing);
+        let image = ra.map(3, |i, a, o| {
+            for c in 0..3 {
+                o[c] = 0.5 * (a[c] + rb.px(i)[c]);
+            }
+        });
+        (image, mse)
+    }
+}
+
+impl Filter for NforFilter {
+    fn name(&self) -> &'static str {
+        "nfor"
+    }
+
+    fn kernel(&self) -> &dyn FilterKernel {
+        &self.kernel
+    }
+
+    fn reads_pixel_buffers(&self) -> bool {
+        true
+    }
+
+    fn reconstruct(&self, film: &Film, _from: SamplerOutput<'_>) -> Vec<Spectrum> {
+        let Some(b) = film.pixel_buffers() else {
+            // A film without half buffers (a stream's own film): its pixel means.
+            return film.pixel_stats().iter().map(|s| s.mean()).collect();
+        };
+        let (image, _) = self.denoise(b, &BANDWIDTHS);
+        image
+            .data
+            .chunks(3)
+            .map(|c| Spectrum::new(c[0], c[1], c[2]).max(Spectrum::ZERO))
+            .collect()
+    }
+
+    fn estimated_error(&self, film: &Film) -> Option<Vec<f32>> {
+        // One bandwidth: half the regression's cost, for a sampler that asks mid-render.
+        film.pixel_buffers()
+            .map(|b| self.denoise(b, &BANDWIDTHS[1..]).1)
+    }
+}
+
+/// The registry entry.
+pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
+    info: PluginInfo {
+        kind: Kind::Filter,
+        name: "nfor",
+        doc: "NFOR (Bitterli et al. 2016): first-order regression on first-hit features, \
+              NL-means weighted across two half buffers, bandwidth chosen per pixel by \
+              estimated MSE, the unfiltered mean a candidate",
+        params: &[
+            ParamSpec::new(
+                "radius",
+                ParamType::Integer,
+                "5",
+                "the regression window's radius in pixels",
+            ),
+            ParamSpec::new(
+                "patch",
+                ParamType::Integer,
+                "3",
+                "the NL-means patch radius in pixels",
+            ),
+            ParamSpec::new(
+                "prefilter",
+                ParamType::Integer,
+                "3",
+                "the feature prefilter's window radius in pixels (0: off)",
+            ),
+            ParamSpec::new(
+                "selectradius",
+                ParamType::Integer,
+                "3",
+                "the radius of the window smoothing the MSE estimates and the per-pixel choice",
+            ),
+            ParamSpec::new(
+                "ridge",
+                ParamType::Float,
+                "0.001",
+                "ridge on the regression's slopes, relative to the sum of weights",
+            ),
+        ],
+    },
+    build,
+};
+
+fn build(c: &Choice) -> Result<Box<dyn Filter>> {
+    let p = &c.params;
+    Ok(Box::new(NforFilter::new(
+        int_in(p, "radius", RADIUS as i32, 0..=16)?,
+        int_in(p, "patch", PATCH as i32, 0..=8)?,
+        int_in(p, "prefilter", PREFILTER_RADIUS as i32, 0..=16)?,
+        int_in(p, "selectradius", SELECT_RADIUS as i32, 0..=16)?,
+        float_in(p, "ridge", RIDGE, 0.0..=1e3)?,
+    )))
+}
