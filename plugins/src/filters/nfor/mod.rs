@@ -13,15 +13,16 @@ mod selection;
 
 use super::{BoxFilter, Filter, FilterBuild, FilterKernel, SamplerOutput};
 use crate::film::{Film, PixelBuffers, Spectrum};
+use crate::first_hit::FEATURES;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use acr_parser::{ParamType, Result};
 use nlmeans::{nl_means, Guide};
 use planes::{Inputs, Planes};
 use regression::Regression;
-use selection::{candidate_mse, select, Candidate, Smoothing};
+use selection::{candidate_mse, select, Candidate, Selected, Smoothing};
 
 /// The regression window's radius by default.
-pub const RADIUS: u32 = 5;
+pub const RADIUS: u32 = 3;
 /// The NL-means patch radius by default (NFOR's and Tungsten's).
 pub const PATCH: u32 = 3;
 /// The feature prefilter's window radius by default.
@@ -30,8 +31,12 @@ pub const PREFILTER_RADIUS: u32 = 3;
 pub const SELECT_RADIUS: u32 = 3;
 /// The ridge on the slopes, relative to the weights' sum.
 pub const RIDGE: f64 = 1e-3;
-/// The NL-means bandwidths of the regression's candidates (NFOR's).
-const BANDWIDTHS: [f32; 2] = [0.5, 1.0];
+/// The NL-means bandwidths of the regression's candidates. NFOR's are 0.5 and 1 with a
+/// variance shared by the halves; with each half's own (unbiased) variance, 1 and 2 measured
+/// lower (docs/reconstruction.md).
+const BANDWIDTHS: [f32; 2] = [1.0, 2.0];
+/// The second pass's bandwidth (NFOR's).
+const SECOND_PASS_K: f32 = 1.0;
 /// The feature prefilter's bandwidth (NFOR's).
 const PREFILTER_K: f32 = 0.5;
 
@@ -43,13 +48,15 @@ pub struct NforFilter {
     prefilter_radius: usize,
     select_radius: usize,
     ridge: f32,
+    /// Whether NFOR's second pass runs.
+    second_pass: bool,
     /// The film keeps pixel statistics only: a box of one pixel.
     kernel: BoxFilter,
 }
 
 impl Default for NforFilter {
     fn default() -> Self {
-        Self::new(RADIUS, PATCH, PREFILTER_RADIUS, SELECT_RADIUS, RIDGE)
+        Self::new(RADIUS, PATCH, PREFILTER_RADIUS, SELECT_RADIUS, RIDGE).with_second_pass(true)
     }
 }
 
@@ -62,12 +69,20 @@ impl NforFilter {
             prefilter_radius: prefilter as usize,
             select_radius: select as usize,
             ridge: ridge as f32,
+            second_pass: true,
             kernel: BoxFilter::new(0.5, 0.5),
         }
     }
 
-    /// The filtered image and its estimated per-pixel MSE, with the bandwidths `ks`.
-    fn denoise(&self, b: &PixelBuffers, ks: &[f32]) -> (Planes, Vec<f32>) {
+    /// The filter with NFOR's second pass on or off.
+    pub fn with_second_pass(mut self, on: bool) -> Self {
+        self.second_pass = on;
+        self
+    }
+
+    /// The filtered image and its estimated per-pixel MSE, with the bandwidths `ks`; with
+    /// `second`, the second pass too.
+    fn denoise(&self, b: &PixelBuffers, ks: &[f32], second: bool) -> (Planes, Vec<f32>) {
         let inp = Inputs::read(b);
         let hit = &inp.hit;
         // Features prefiltered across the halves: each half's features averaged with
@@ -75,7 +90,7 @@ impl NforFilter {
         let prefiltered = [0, 1].map(|h| {
             let guide = Guide {
                 image: &inp.features[1 - h],
-                variance: &inp.features_var,
+                variance: &inp.features_var[1 - h],
                 patch: self.patch,
                 k2: PREFILTER_K * PREFILTER_K,
             };
@@ -93,7 +108,7 @@ impl NforFilter {
             };
             let guide = Guide {
                 image: &inp.color[1 - h],
-                variance: &inp.color_var,
+                variance: &inp.color_var[1 - h],
                 patch: self.patch,
                 k2: 1.0,
             };
@@ -106,6 +121,7 @@ impl NforFilter {
         for (a, b) in fa.into_iter().zip(fb) {
             candidates.push(Candidate { halves: [a, b] });
         }
+        // The unfiltered mean's MSE is its variance.
         let mut mses = vec![(0..inp.full_var.w * inp.full_var.h)
             .map(|i| inp.full_var.px(i).iter().sum::<f32>() / 3.0)
             .collect::<Vec<f32>>()];
@@ -122,13 +138,62 @@ impl NforFilter {
             radius: self.select_radius,
             hit,
         };
-        let ([ra, rb], mse) = select(&candidates, &mses, &smoothing);
-        let image = ra.map(3, |i, a, o| {
+        let sel = select(&candidates, &mses, &smoothing);
+        drop(candidates);
+        let [ra, rb] = &sel.halves;
+        let first = ra.map(3, |i, a, o| {
             for c in 0..3 {
                 o[c] = 0.5 * (a[c] + rb.px(i)[c]);
             }
         });
-        (image, mse)
+        if !second {
+            return (first, sel.mse);
+        }
+        let features = prefiltered[0].map(FEATURES, |i, a, o| {
+            for (k, o) in o.iter_mut().enumerate() {
+                *o = 0.5 * (a[k] + prefiltered[1].px(i)[k]);
+            }
+        });
+        let image = self.second_pass(&inp, &sel, &first, &features);
+        (image, sel.mse)
+    }
+
+    /// NFOR's second pass: the first pass's image regressed again on the features, weighted
+    /// by NL-means on itself with the halves' difference as its variance. Where the choice
+    /// took the unfiltered mean, the mean keeps its share.
+    fn second_pass(
+        &self,
+        inp: &Inputs,
+        sel: &Selected,
+        first: &Planes,
+        features: &Planes,
+    ) -> Planes {
+        let [ra, rb] = &sel.halves;
+        let var = ra.map(3, |i, a, o| {
+            for c in 0..3 {
+                o[c] = 0.25 * (a[c] - rb.px(i)[c]).powi(2);
+            }
+        });
+        let reg = Regression {
+            color: first,
+            features,
+            hit: &inp.hit,
+            radius: self.radius,
+            ridge: self.ridge,
+        };
+        let guide = Guide {
+            image: first,
+            variance: &var,
+            patch: self.patch,
+            k2: 1.0,
+        };
+        let second = reg.run(guide, &[SECOND_PASS_K]).remove(0);
+        second.map(3, |i, v, o| {
+            let s = sel.first_share[i];
+            for c in 0..3 {
+                o[c] = s * inp.full.px(i)[c] + (1.0 - s) * v[c];
+            }
+        })
     }
 }
 
@@ -150,7 +215,7 @@ impl Filter for NforFilter {
             // A film without half buffers (a stream's own film): its pixel means.
             return film.pixel_stats().iter().map(|s| s.mean()).collect();
         };
-        let (image, _) = self.denoise(b, &BANDWIDTHS);
+        let (image, _) = self.denoise(b, &BANDWIDTHS, self.second_pass);
         image
             .data
             .chunks(3)
@@ -161,7 +226,7 @@ impl Filter for NforFilter {
     fn estimated_error(&self, film: &Film) -> Option<Vec<f32>> {
         // One bandwidth: half the regression's cost, for a sampler that asks mid-render.
         film.pixel_buffers()
-            .map(|b| self.denoise(b, &BANDWIDTHS[1..]).1)
+            .map(|b| self.denoise(b, &BANDWIDTHS[..1], false).1)
     }
 }
 
@@ -177,8 +242,14 @@ pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
             ParamSpec::new(
                 "radius",
                 ParamType::Integer,
-                "5",
+                "3",
                 "the regression window's radius in pixels",
+            ),
+            ParamSpec::new(
+                "secondpass",
+                ParamType::Bool,
+                "true",
+                "NFOR's second pass: the first pass's image regressed again on the features",
             ),
             ParamSpec::new(
                 "patch",
@@ -211,11 +282,14 @@ pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
 
 fn build(c: &Choice) -> Result<Box<dyn Filter>> {
     let p = &c.params;
-    Ok(Box::new(NforFilter::new(
-        int_in(p, "radius", RADIUS as i32, 0..=16)?,
-        int_in(p, "patch", PATCH as i32, 0..=8)?,
-        int_in(p, "prefilter", PREFILTER_RADIUS as i32, 0..=16)?,
-        int_in(p, "selectradius", SELECT_RADIUS as i32, 0..=16)?,
-        float_in(p, "ridge", RIDGE, 0.0..=1e3)?,
-    )))
+    Ok(Box::new(
+        NforFilter::new(
+            int_in(p, "radius", RADIUS as i32, 0..=16)?,
+            int_in(p, "patch", PATCH as i32, 0..=8)?,
+            int_in(p, "prefilter", PREFILTER_RADIUS as i32, 0..=16)?,
+            int_in(p, "selectradius", SELECT_RADIUS as i32, 0..=16)?,
+            float_in(p, "ridge", RIDGE, 0.0..=1e3)?,
+        )
+        .with_second_pass(p.bool_or("secondpass", true)?),
+    ))
 }

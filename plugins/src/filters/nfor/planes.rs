@@ -46,17 +46,77 @@ impl Planes {
     }
 }
 
+/// A rectangle of pixels, `x0..x1` by `y0..y1`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rect {
+    pub x0: usize,
+    pub x1: usize,
+    pub y0: usize,
+    pub y1: usize,
+}
+
+impl Rect {
+    /// Its width.
+    pub fn w(&self) -> usize {
+        self.x1 - self.x0
+    }
+
+    /// Its pixel count.
+    pub fn len(&self) -> usize {
+        (self.x1 - self.x0) * (self.y1 - self.y0)
+    }
+}
+
+/// The side of the square tiles the filter works by: small enough that a tile's regression
+/// sums stay in cache.
+pub(crate) const TILE: usize = 32;
+
+/// A `w` x `h` image of `c` channels made tile by tile in parallel: `tile` returns a tile's
+/// pixels (row-major over the tile, `c` channels each). Each pixel is computed within its
+/// tile alone, so the result does not depend on the thread count.
+pub(crate) fn by_tiles(
+    w: usize,
+    h: usize,
+    c: usize,
+    tile: impl Fn(Rect) -> Vec<f32> + Sync,
+) -> Planes {
+    use rayon::prelude::*;
+    let (tw, th) = (w.div_ceil(TILE), h.div_ceil(TILE));
+    let tiles: Vec<(Rect, Vec<f32>)> = (0..tw * th)
+        .into_par_iter()
+        .map(|t| {
+            let (tx, ty) = (t % tw, t / tw);
+            let r = Rect {
+                x0: tx * TILE,
+                x1: ((tx + 1) * TILE).min(w),
+                y0: ty * TILE,
+                y1: ((ty + 1) * TILE).min(h),
+            };
+            (r, tile(r))
+        })
+        .collect();
+    let mut out = Planes::new(w, h, c);
+    for (r, vals) in tiles {
+        let rw = r.w() * c;
+        for (j, y) in (r.y0..r.y1).enumerate() {
+            out.data[(y * w + r.x0) * c..][..rw].copy_from_slice(&vals[j * rw..][..rw]);
+        }
+    }
+    out
+}
+
 /// What the filter reads from the half buffers: per half the mean colour and features with
 /// the variances of those means, and which pixels had a first hit at all.
 pub(crate) struct Inputs {
     /// Each half's mean colour (3 channels).
     pub color: [Planes; 2],
-    /// The variance of one half's mean colour (both halves' estimates averaged).
-    pub color_var: Planes,
+    /// The variance of each half's mean colour, each estimated from that half's samples
+    /// alone: weights drawn from one half must not depend on the other half's noise.
+    pub color_var: [Planes; 2],
     /// Each half's mean features (depth rescaled to the image's mean depth).
     pub features: [Planes; 2],
-    /// The variance of one half's mean features.
-    pub features_var: Planes,
+    /// The variance of each half's mean features.
+    pub features_var: [Planes; 2],
     /// The pixel mean over both halves (3 channels).
     pub full: Planes,
     /// The variance of that mean.
@@ -64,6 +124,38 @@ pub(crate) struct Inputs {
     /// Whether some sample of the pixel met a surface (features not all zero): a pixel that
     /// sees only emitters or nothing is filtered apart from surfaces.
     pub hit: Vec<bool>,
+}
+
+/// The radius of the box that steadies the halves' variance estimates.
+const VARIANCE_RADIUS: i64 = 1;
+
+/// `img` averaged over each pixel's neighbours within `r` pixels of the same `group`.
+fn box_in_group(img: &Planes, group: &[bool], r: i64) -> Planes {
+    let (w, h, c) = (img.w as i64, img.h as i64, img.c);
+    let mut out = Planes::new(img.w, img.h, c);
+    for y in 0..h {
+        for x in 0..w {
+            let p = (y * w + x) as usize;
+            let mut n = 0.0;
+            for (qx, qy) in (-r..=r).flat_map(|dy| (-r..=r).map(move |dx| (x + dx, y + dy))) {
+                if qx < 0 || qy < 0 || qx >= w || qy >= h {
+                    continue;
+                }
+                let q = (qy * w + qx) as usize;
+                if group[q] != group[p] {
+                    continue;
+                }
+                n += 1.0;
+                for ch in 0..c {
+                    out.data[p * c + ch] += img.data[q * c + ch];
+                }
+            }
+            for v in out.px_mut(p) {
+                *v /= n;
+            }
+        }
+    }
+    out
 }
 
 /// The variance of a half's mean: its own estimate, else the other half's scaled by the
@@ -102,9 +194,9 @@ impl Inputs {
         };
         let mut inp = Inputs {
             color: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
-            color_var: Planes::new(w, h, 3),
+            color_var: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
             features: [Planes::new(w, h, FEATURES), Planes::new(w, h, FEATURES)],
-            features_var: Planes::new(w, h, FEATURES),
+            features_var: [Planes::new(w, h, FEATURES), Planes::new(w, h, FEATURES)],
             full: Planes::new(w, h, 3),
             full_var: Planes::new(w, h, 3),
             hit: vec![false; n],
@@ -118,6 +210,11 @@ impl Inputs {
                 _ => (pa, pb),
             };
             inp.read_pixel(i, [pa, pb], depth_scale);
+        }
+        // A half's variance from a few samples is itself noisy: averaged over 3x3 pixels of
+        // the same kind it steadies the NL-means distances.
+        for h in 0..2 {
+            inp.color_var[h] = box_in_group(&inp.color_var[h], &inp.hit, VARIANCE_RADIUS);
         }
         inp
     }
@@ -156,7 +253,8 @@ impl Inputs {
         for c in 0..3 {
             self.color[0].px_mut(i)[c] = pa.color[c];
             self.color[1].px_mut(i)[c] = pb.color[c];
-            self.color_var.px_mut(i)[c] = 0.5 * (va[c] + vb[c]);
+            self.color_var[0].px_mut(i)[c] = va[c];
+            self.color_var[1].px_mut(i)[c] = vb[c];
             self.full.px_mut(i)[c] = (na * pa.color[c] + nb * pb.color[c]) / t;
             self.full_var.px_mut(i)[c] = (na * na * va[c] + nb * nb * vb[c]) / (t * t);
         }
@@ -165,7 +263,8 @@ impl Inputs {
             let s = scale(k);
             self.features[0].px_mut(i)[k] = pa.features[k] * s;
             self.features[1].px_mut(i)[k] = pb.features[k] * s;
-            self.features_var.px_mut(i)[k] = 0.5 * (fa[k] + fb[k]) * s * s;
+            self.features_var[0].px_mut(i)[k] = fa[k] * s * s;
+            self.features_var[1].px_mut(i)[k] = fb[k] * s * s;
         }
         self.hit[i] = pa.features.iter().chain(&pb.features).any(|&f| f != 0.0);
     }

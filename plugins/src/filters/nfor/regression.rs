@@ -3,17 +3,16 @@
 //! the pixel's own (a plane in feature space), weighted by NL-means on a guide image. Several
 //! bandwidths share the window's distances.
 
-use super::nlmeans::{weight, Guide, Scratch, BAND};
-use super::planes::Planes;
+use super::nlmeans::{weight, Guide, Scratch};
+use super::planes::{Planes, Rect, TILE};
 use crate::first_hit::FEATURES;
-use rayon::prelude::*;
 
 /// Unknowns of the fit: the intercept and one slope per feature.
 const D: usize = 1 + FEATURES;
-/// Entries of the upper triangle of the normal matrix.
-const TRI: usize = D * (D + 1) / 2;
+/// The normal matrix is kept whole (D x D, not the triangle): the update vectorises.
+const GRAM: usize = D * D;
 /// Accumulators per pixel and bandwidth: the normal matrix and three right-hand sides.
-const ACC: usize = TRI + 3 * D;
+const ACC: usize = GRAM + 3 * D;
 
 /// Weights below this add nothing measurable and are skipped.
 const MIN_WEIGHT: f32 = 1e-4;
@@ -35,116 +34,165 @@ pub(crate) struct Regression<'a> {
 
 impl Regression<'_> {
     /// The fitted image for each bandwidth `k` of `ks`, the weights from `guide` (whose
-    /// `k2` is ignored: each bandwidth scales the distances).
+    /// `k2` is ignored: each bandwidth scales the distances). Collaborative, as Tungsten's:
+    /// each pixel's fit predicts every pixel of its window, and a pixel is the weighted mean
+    /// of the predictions it received. Tiles are summed in a fixed order.
     pub fn run(&self, guide: Guide<'_>, ks: &[f32]) -> Vec<Planes> {
+        use rayon::prelude::*;
         let (w, h) = (self.color.w, self.color.h);
         let nk = ks.len();
         let guide = Guide { k2: 1.0, ..guide };
         let inv_k2: Vec<f32> = ks.iter().map(|k| 1.0 / (k * k)).collect();
-        let bands: Vec<Vec<f32>> = (0..h.div_ceil(BAND))
+        let (tw, th) = (w.div_ceil(TILE), h.div_ceil(TILE));
+        let tiles: Vec<(Rect, Vec<f32>)> = (0..tw * th)
             .into_par_iter()
-            .map(|band| {
-                let (y0, y1) = (band * BAND, ((band + 1) * BAND).min(h));
-                self.band(guide, &inv_k2, (y0, y1))
+            .map(|t| {
+                let (tx, ty) = (t % tw, t / tw);
+                let rect = Rect {
+                    x0: tx * TILE,
+                    x1: ((tx + 1) * TILE).min(w),
+                    y0: ty * TILE,
+                    y1: ((ty + 1) * TILE).min(h),
+                };
+                self.tile(guide, &inv_k2, rect)
             })
             .collect();
+        // Per pixel, per bandwidth: the predictions' weighted sums and their weight.
+        let mut sums = Planes::new(w, h, 4 * nk);
+        for (r, vals) in tiles {
+            let rw = r.w() * 4 * nk;
+            for (j, y) in (r.y0..r.y1).enumerate() {
+                let dst = &mut sums.data[(y * w + r.x0) * 4 * nk..][..rw];
+                for (d, v) in dst.iter_mut().zip(&vals[j * rw..][..rw]) {
+                    *d += v;
+                }
+            }
+        }
         (0..nk)
             .map(|k| {
-                let mut out = Planes::new(w, h, 3);
-                for (band, vals) in bands.iter().enumerate() {
-                    let y0 = band * BAND;
-                    let n = vals.len() / (3 * nk);
-                    for j in 0..n {
-                        let o = (y0 * w + j) * 3;
-                        out.data[o..o + 3].copy_from_slice(&vals[(j * nk + k) * 3..][..3]);
+                sums.map(3, |_, v, o| {
+                    let s = &v[k * 4..k * 4 + 4];
+                    for c in 0..3 {
+                        o[c] = if s[3] > 0.0 { s[c] / s[3] } else { 0.0 };
                     }
-                }
-                out
+                })
             })
             .collect()
     }
 
-    /// The fits of rows `y0..y1`: per pixel, per bandwidth, three channels.
-    fn band(&self, guide: Guide<'_>, inv_k2: &[f32], (y0, y1): (usize, usize)) -> Vec<f32> {
-        let w = self.color.w;
+    /// The fits of the pixels of `rect` and their predictions: the rectangle grown by the
+    /// window (clipped to the image) and, per pixel of it, per bandwidth, the predictions'
+    /// weighted sums (3) and weight.
+    fn tile(&self, guide: Guide<'_>, inv_k2: &[f32], rect: Rect) -> (Rect, Vec<f32>) {
+        let (w, h) = (self.color.w, self.color.h);
         let nk = inv_k2.len();
-        let n = (y1 - y0) * w;
-        let mut acc = vec![0.0f32; n * nk * ACC];
-        let mut scratch = Scratch::default();
-        let mut dist = Vec::new();
+        let rw = rect.w();
         let r = self.radius as i64;
-        for dy in -r..=r {
-            for dx in -r..=r {
-                guide.patch_distances((dx, dy), (y0, y1), &mut scratch, &mut dist);
-                for (j, &d) in dist.iter().enumerate() {
-                    if d == f32::INFINITY {
-                        continue;
+        // Each offset with its index step.
+        let offsets: Vec<((i64, i64), i64)> = (-r..=r)
+            .flat_map(|dy| (-r..=r).map(move |dx| ((dx, dy), dy * w as i64 + dx)))
+            .collect();
+        let mut scratch = Scratch::default();
+        let mut dist = vec![Vec::new(); offsets.len()];
+        for (o, &(off, _)) in offsets.iter().enumerate() {
+            guide.patch_distances(off, rect, &mut scratch, &mut dist[o]);
+        }
+        let x_of = |p: usize, q: usize| {
+            let (fp, fq) = (self.features.px(p), self.features.px(q));
+            let mut x = [1.0f32; D];
+            for k in 0..FEATURES {
+                x[k + 1] = fq[k] - fp[k];
+            }
+            x
+        };
+        let out_rect = Rect {
+            x0: rect.x0.saturating_sub(self.radius),
+            x1: (rect.x1 + self.radius).min(w),
+            y0: rect.y0.saturating_sub(self.radius),
+            y1: (rect.y1 + self.radius).min(h),
+        };
+        let ow = out_rect.w();
+        let mut out = vec![0.0f32; out_rect.len() * 4 * nk];
+        let mut near_k: Vec<(usize, f32, [f32; D])> = Vec::with_capacity(offsets.len());
+        for j in 0..rect.len() {
+            let p = (rect.y0 + j / rw) * w + rect.x0 + j % rw;
+            let hit = self.hit[p];
+            let dist = &dist;
+            let offsets = &offsets;
+            // The neighbours that weigh in and their distances.
+            let near = || {
+                offsets
+                    .iter()
+                    .enumerate()
+                    .filter_map(move |(o, &(_, step))| {
+                        let d = dist[o][j];
+                        let q = (p as i64 + step) as usize;
+                        (d != f32::INFINITY && self.hit[q] == hit).then_some((q, d))
+                    })
+            };
+            for (k, &s) in inv_k2.iter().enumerate() {
+                // The neighbours that weigh in: index, weight, features.
+                near_k.clear();
+                near_k.extend(near().filter_map(|(q, d)| {
+                    let wt = weight(d * s);
+                    (wt >= MIN_WEIGHT).then(|| (q, wt, x_of(p, q)))
+                }));
+                let mut a = [0.0f32; ACC];
+                for (q, wt, x) in &near_k {
+                    let y = self.color.px(*q);
+                    accumulate(&mut a, x, &[y[0], y[1], y[2]], *wt);
+                }
+                let beta = solve(&a, self.ridge);
+                for (q, wt, x) in &near_k {
+                    let local = (q / w - out_rect.y0) * ow + q % w - out_rect.x0;
+                    let dst = &mut out[(local * nk + k) * 4..][..4];
+                    for c in 0..3 {
+                        let pred: f32 = beta[c].iter().zip(x).map(|(b, x)| b * x).sum();
+                        dst[c] += wt * pred;
                     }
-                    let p = y0 * w + j;
-                    let q = (p as i64 + dy * w as i64 + dx) as usize;
-                    if self.hit[p] != self.hit[q] {
-                        continue;
-                    }
-                    let (fp, fq) = (self.features.px(p), self.features.px(q));
-                    let mut x = [1.0f32; D];
-                    for k in 0..FEATURES {
-                        x[k + 1] = fq[k] - fp[k];
-                    }
-                    let y = self.color.px(q);
-                    for (k, &s) in inv_k2.iter().enumerate() {
-                        let wt = weight(d * s);
-                        if wt < MIN_WEIGHT {
-                            continue;
-                        }
-                        let a = &mut acc[(j * nk + k) * ACC..][..ACC];
-                        accumulate(a, &x, y, wt);
-                    }
+                    dst[3] += wt;
                 }
             }
         }
-        let mut out = vec![0.0f32; n * nk * 3];
-        for (a, o) in acc.chunks(ACC).zip(out.chunks_mut(3)) {
-            o.copy_from_slice(&solve(a, self.ridge));
-        }
-        out
+        (out_rect, out)
     }
 }
 
 /// Adds one neighbour (features `x`, colour `y`, weight `wt`) to the normal equations.
 #[inline]
-fn accumulate(a: &mut [f32], x: &[f32; D], y: &[f32], wt: f32) {
-    let mut t = 0;
-    for i in 0..D {
-        let wx = wt * x[i];
-        for xj in &x[i..] {
-            a[t] += wx * xj;
-            t += 1;
+fn accumulate(a: &mut [f32; ACC], x: &[f32; D], y: &[f32; 3], wt: f32) {
+    let (gram, rhs) = a.split_at_mut(GRAM);
+    for (row, &xi) in gram.chunks_exact_mut(D).zip(x) {
+        let wx = wt * xi;
+        for (g, &xj) in row.iter_mut().zip(x) {
+            *g += wx * xj;
         }
     }
-    for c in 0..3 {
-        let wy = wt * y[c];
-        for i in 0..D {
-            a[TRI + c * D + i] += wy * x[i];
+    for (row, &yc) in rhs.chunks_exact_mut(D).zip(y) {
+        let wy = wt * yc;
+        for (r, &xi) in row.iter_mut().zip(x) {
+            *r += wy * xi;
         }
     }
 }
 
-/// The intercepts of the three channels' fits from the normal equations `a`, with a ridge
-/// on the slopes of `ridge` times the sum of weights; the weighted mean where the system is
-/// singular.
-fn solve(a: &[f32], ridge: f32) -> [f32; 3] {
+/// The three channels' fits (intercept and slopes) from the normal equations `a`, with a
+/// ridge on the slopes of `ridge` times the sum of weights; the weighted mean where the
+/// system is singular.
+fn solve(a: &[f32], ridge: f32) -> [[f32; D]; 3] {
     let sw = f64::from(a[0]);
     if sw <= 0.0 {
-        return [0.0; 3];
+        return [[0.0; D]; 3];
     }
-    let mean = [0, 1, 2].map(|c| (f64::from(a[TRI + c * D]) / sw) as f32);
+    let mean = [0, 1, 2].map(|c| {
+        let mut b = [0.0f32; D];
+        b[0] = (f64::from(a[GRAM + c * D]) / sw) as f32;
+        b
+    });
     let mut m = [[0.0f64; D]; D];
-    let mut t = 0;
-    for i in 0..D {
-        for j in i..D {
-            m[i][j] = f64::from(a[t]);
-            m[j][i] = m[i][j];
-            t += 1;
+    for (i, row) in m.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = f64::from(a[i * D + j]);
         }
     }
     for (i, row) in m.iter_mut().enumerate().skip(1) {
@@ -169,11 +217,11 @@ fn solve(a: &[f32], ridge: f32) -> [f32; 3] {
             m[i][j] = s / l;
         }
     }
-    let mut out = [0.0f32; 3];
+    let mut out = [[0.0f32; D]; 3];
     for (c, o) in out.iter_mut().enumerate() {
         let mut z = [0.0f64; D];
         for i in 0..D {
-            let mut s = f64::from(a[TRI + c * D + i]);
+            let mut s = f64::from(a[GRAM + c * D + i]);
             for k in 0..i {
                 s -= m[i][k] * z[k];
             }
@@ -187,11 +235,10 @@ fn solve(a: &[f32], ridge: f32) -> [f32; 3] {
             }
             b[i] = s / m[i][i];
         }
-        *o = if b[0].is_finite() {
-            b[0] as f32
-        } else {
-            mean[c]
-        };
+        if !b.iter().all(|v| v.is_finite()) {
+            return mean;
+        }
+        *o = b.map(|v| v as f32);
     }
     out
 }

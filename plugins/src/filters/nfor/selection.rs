@@ -15,16 +15,19 @@ pub(crate) struct Candidate {
 /// The estimated MSE (mean over the channels) of the mean of a candidate's two halves:
 /// each half's squared difference from the other half less that half's variance, averaged,
 /// less the variance the averaging removes (NFOR's estimate, as Tungsten computes it).
-pub(crate) fn candidate_mse(c: &Candidate, halves: &[Planes; 2], half_var: &Planes) -> Vec<f32> {
+pub(crate) fn candidate_mse(
+    c: &Candidate,
+    halves: &[Planes; 2],
+    half_var: &[Planes; 2],
+) -> Vec<f32> {
     let [fa, fb] = &c.halves;
     let [a, b] = halves;
     (0..a.w * a.h)
         .map(|i| {
             let mut s = 0.0;
             for ch in 0..3 {
-                let v = half_var.px(i)[ch];
-                let ma = (b.px(i)[ch] - fa.px(i)[ch]).powi(2) - v;
-                let mb = (a.px(i)[ch] - fb.px(i)[ch]).powi(2) - v;
+                let ma = (b.px(i)[ch] - fa.px(i)[ch]).powi(2) - half_var[1].px(i)[ch];
+                let mb = (a.px(i)[ch] - fb.px(i)[ch]).powi(2) - half_var[0].px(i)[ch];
                 let resid = 0.25 * (fa.px(i)[ch] - fb.px(i)[ch]).powi(2);
                 s += 0.5 * (ma + mb) - resid;
             }
@@ -41,6 +44,16 @@ pub(crate) struct Smoothing<'a> {
     pub hit: &'a [bool],
 }
 
+/// What the choice made.
+pub(crate) struct Selected {
+    /// The blend of the candidates, each half.
+    pub halves: [Planes; 2],
+    /// Its estimated MSE per pixel.
+    pub mse: Vec<f32>,
+    /// The first candidate's share of each pixel's blend.
+    pub first_share: Vec<f32>,
+}
+
 /// The per-pixel blend of the candidates (each half), and its estimated MSE: the raw MSE maps
 /// `mses` (one per candidate) are smoothed, each pixel picks the lowest, and the one-hot
 /// choice maps are smoothed into blend weights.
@@ -48,7 +61,7 @@ pub(crate) fn select(
     candidates: &[Candidate],
     mses: &[Vec<f32>],
     smoothing: &Smoothing<'_>,
-) -> ([Planes; 2], Vec<f32>) {
+) -> Selected {
     let nc = candidates.len();
     let (w, h) = (candidates[0].halves[0].w, candidates[0].halves[0].h);
     let n = w * h;
@@ -80,5 +93,9 @@ pub(crate) fn select(
             mse[i] += s[c] * smooth.px(i)[c].max(0.0);
         }
     }
-    (out, mse)
+    Selected {
+        halves: out,
+        mse,
+        first_share: (0..n).map(|i| weights.px(i)[0]).collect(),
+    }
 }
