@@ -293,3 +293,6 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
         .with_second_pass(p.bool_or("secondpass", true)?),
     ))
 }
+
+#[cfg(test)]
+mod tests;
