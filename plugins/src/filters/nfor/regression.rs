@@ -9,10 +9,10 @@ use crate::first_hit::FEATURES;
 
 /// Unknowns of the fit: the intercept and one slope per feature.
 const D: usize = 1 + FEATURES;
-/// The normal matrix is kept whole (D x D, not the triangle): the update vectorises.
-const GRAM: usize = D * D;
-/// Accumulators per pixel and bandwidth: the normal matrix and three right-hand sides.
-const ACC: usize = GRAM + 3 * D;
+/// The normal equations of one fit: rows 0..D the normal matrix, kept whole (not the
+/// triangle) so that each row's update is one vector operation, rows D..D + 3 the three
+/// channels' right-hand sides.
+type Normal = [[f32; D]; D + 3];
 
 /// Weights below this add nothing measurable and are skipped.
 const MIN_WEIGHT: f32 = 1e-4;
@@ -93,9 +93,15 @@ impl Regression<'_> {
             .flat_map(|dy| (-r..=r).map(move |dx| ((dx, dy), dy * w as i64 + dx)))
             .collect();
         let mut scratch = Scratch::default();
-        let mut dist = vec![Vec::new(); offsets.len()];
+        // The distances pixel by pixel (each pixel's offsets together), as they are read.
+        let no = offsets.len();
+        let mut dist = vec![0.0f32; rect.len() * no];
+        let mut row = Vec::new();
         for (o, &(off, _)) in offsets.iter().enumerate() {
-            guide.patch_distances(off, rect, &mut scratch, &mut dist[o]);
+            guide.patch_distances(off, rect, &mut scratch, &mut row);
+            for (j, d) in row.iter().enumerate() {
+                dist[j * no + o] = *d;
+            }
         }
         let x_of = |p: usize, q: usize| {
             let (fp, fq) = (self.features.px(p), self.features.px(q));
@@ -117,7 +123,7 @@ impl Regression<'_> {
         for j in 0..rect.len() {
             let p = (rect.y0 + j / rw) * w + rect.x0 + j % rw;
             let hit = self.hit[p];
-            let dist = &dist;
+            let dist = &dist[j * no..(j + 1) * no];
             let offsets = &offsets;
             // The neighbours that weigh in and their distances.
             let near = || {
@@ -125,7 +131,7 @@ impl Regression<'_> {
                     .iter()
                     .enumerate()
                     .filter_map(move |(o, &(_, step))| {
-                        let d = dist[o][j];
+                        let d = dist[o];
                         let q = (p as i64 + step) as usize;
                         (d != f32::INFINITY && self.hit[q] == hit).then_some((q, d))
                     })
@@ -137,7 +143,7 @@ impl Regression<'_> {
                     let wt = weight(d * s);
                     (wt >= MIN_WEIGHT).then(|| (q, wt, x_of(p, q)))
                 }));
-                let mut a = [0.0f32; ACC];
+                let mut a: Normal = [[0.0; D]; D + 3];
                 for (q, wt, x) in &near_k {
                     let y = self.color.px(*q);
                     accumulate(&mut a, x, &[y[0], y[1], y[2]], *wt);
@@ -160,18 +166,18 @@ impl Regression<'_> {
 
 /// Adds one neighbour (features `x`, colour `y`, weight `wt`) to the normal equations.
 #[inline]
-fn accumulate(a: &mut [f32; ACC], x: &[f32; D], y: &[f32; 3], wt: f32) {
-    let (gram, rhs) = a.split_at_mut(GRAM);
-    for (row, &xi) in gram.chunks_exact_mut(D).zip(x) {
-        let wx = wt * xi;
-        for (g, &xj) in row.iter_mut().zip(x) {
-            *g += wx * xj;
+fn accumulate(a: &mut Normal, x: &[f32; D], y: &[f32; 3], wt: f32) {
+    let (gram, rhs) = a.split_at_mut(D);
+    for i in 0..D {
+        let wx = wt * x[i];
+        for j in 0..D {
+            gram[i][j] += wx * x[j];
         }
     }
-    for (row, &yc) in rhs.chunks_exact_mut(D).zip(y) {
-        let wy = wt * yc;
-        for (r, &xi) in row.iter_mut().zip(x) {
-            *r += wy * xi;
+    for c in 0..3 {
+        let wy = wt * y[c];
+        for i in 0..D {
+            rhs[c][i] += wy * x[i];
         }
     }
 }
@@ -179,20 +185,20 @@ fn accumulate(a: &mut [f32; ACC], x: &[f32; D], y: &[f32; 3], wt: f32) {
 /// The three channels' fits (intercept and slopes) from the normal equations `a`, with a
 /// ridge on the slopes of `ridge` times the sum of weights; the weighted mean where the
 /// system is singular.
-fn solve(a: &[f32], ridge: f32) -> [[f32; D]; 3] {
-    let sw = f64::from(a[0]);
+fn solve(a: &Normal, ridge: f32) -> [[f32; D]; 3] {
+    let sw = f64::from(a[0][0]);
     if sw <= 0.0 {
         return [[0.0; D]; 3];
     }
     let mean = [0, 1, 2].map(|c| {
         let mut b = [0.0f32; D];
-        b[0] = (f64::from(a[GRAM + c * D]) / sw) as f32;
+        b[0] = (f64::from(a[D + c][0]) / sw) as f32;
         b
     });
     let mut m = [[0.0f64; D]; D];
     for (i, row) in m.iter_mut().enumerate() {
         for (j, v) in row.iter_mut().enumerate() {
-            *v = f64::from(a[i * D + j]);
+            *v = f64::from(a[i][j]);
         }
     }
     for (i, row) in m.iter_mut().enumerate().skip(1) {
@@ -221,7 +227,7 @@ fn solve(a: &[f32], ridge: f32) -> [[f32; D]; 3] {
     for (c, o) in out.iter_mut().enumerate() {
         let mut z = [0.0f64; D];
         for i in 0..D {
-            let mut s = f64::from(a[GRAM + c * D + i]);
+            let mut s = f64::from(a[D + c][i]);
             for k in 0..i {
                 s -= m[i][k] * z[k];
             }
