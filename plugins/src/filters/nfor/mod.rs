@@ -83,19 +83,20 @@ impl NforFilter {
     /// The filtered image and its estimated per-pixel MSE, with the bandwidths `ks`; with
     /// `second`, the second pass too.
     fn denoise(&self, b: &PixelBuffers, ks: &[f32], second: bool) -> (Planes, Vec<f32>) {
-        let inp = Inputs::read(b);
+        let (inp, feats) = Inputs::read(b);
         let hit = &inp.hit;
         // Features prefiltered across the halves: each half's features averaged with
         // weights from the other half's.
         let prefiltered = [0, 1].map(|h| {
             let guide = Guide {
-                image: &inp.features[1 - h],
-                variance: &inp.features_var[1 - h],
+                image: &feats.features[1 - h],
+                variance: &feats.variance[1 - h],
                 patch: self.patch,
                 k2: PREFILTER_K * PREFILTER_K,
             };
-            nl_means(&inp.features[h], guide, self.prefilter_radius, hit)
+            nl_means(&feats.features[h], guide, self.prefilter_radius, hit)
         });
+        drop(feats);
         // Each half fitted on the other half's prefiltered features with weights from the
         // other half's colour (Tungsten's crossing).
         let fits = [0, 1].map(|h| {

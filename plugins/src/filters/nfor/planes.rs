@@ -113,10 +113,6 @@ pub(crate) struct Inputs {
     /// The variance of each half's mean colour, each estimated from that half's samples
     /// alone: weights drawn from one half must not depend on the other half's noise.
     pub color_var: [Planes; 2],
-    /// Each half's mean features (depth rescaled to the image's mean depth).
-    pub features: [Planes; 2],
-    /// The variance of each half's mean features.
-    pub features_var: [Planes; 2],
     /// The pixel mean over both halves (3 channels).
     pub full: Planes,
     /// The variance of that mean.
@@ -158,6 +154,13 @@ fn box_in_group(img: &Planes, group: &[bool], r: i64) -> Planes {
     out
 }
 
+/// Each half's mean features (depth rescaled to the image's mean depth) and their variance:
+/// read with [`Inputs`], and dropped once prefiltered.
+pub(crate) struct FeatureHalves {
+    pub features: [Planes; 2],
+    pub variance: [Planes; 2],
+}
+
 /// The variance of a half's mean: its own estimate, else the other half's scaled by the
 /// counts, else from the halves' difference (one sample each).
 fn half_variance<const N: usize>(
@@ -174,7 +177,7 @@ fn half_variance<const N: usize>(
 
 impl Inputs {
     /// Reads the buffers. A half without samples takes the other half's values.
-    pub fn read(b: &PixelBuffers) -> Self {
+    pub fn read(b: &PixelBuffers) -> (Self, FeatureHalves) {
         let (w, h) = b.size();
         let (w, h) = (w as usize, h as usize);
         let n = w * h;
@@ -195,11 +198,13 @@ impl Inputs {
         let mut inp = Inputs {
             color: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
             color_var: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
-            features: [Planes::new(w, h, FEATURES), Planes::new(w, h, FEATURES)],
-            features_var: [Planes::new(w, h, FEATURES), Planes::new(w, h, FEATURES)],
             full: Planes::new(w, h, 3),
             full_var: Planes::new(w, h, 3),
             hit: vec![false; n],
+        };
+        let mut feats = FeatureHalves {
+            features: [Planes::new(w, h, FEATURES), Planes::new(w, h, FEATURES)],
+            variance: [Planes::new(w, h, FEATURES), Planes::new(w, h, FEATURES)],
         };
         for i in 0..n {
             let (pa, pb) = (&a[i], &bb[i]);
@@ -209,18 +214,24 @@ impl Inputs {
                 (_, 0) => (pa, pa),
                 _ => (pa, pb),
             };
-            inp.read_pixel(i, [pa, pb], depth_scale);
+            inp.read_pixel(i, [pa, pb], depth_scale, &mut feats);
         }
         // A half's variance from a few samples is itself noisy: averaged over 3x3 pixels of
         // the same kind it steadies the NL-means distances.
         for h in 0..2 {
             inp.color_var[h] = box_in_group(&inp.color_var[h], &inp.hit, VARIANCE_RADIUS);
         }
-        inp
+        (inp, feats)
     }
 
     /// Fills pixel `i` from its two halves (both with samples).
-    fn read_pixel(&mut self, i: usize, [pa, pb]: [&HalfPixel; 2], depth_scale: f32) {
+    fn read_pixel(
+        &mut self,
+        i: usize,
+        [pa, pb]: [&HalfPixel; 2],
+        depth_scale: f32,
+        feats: &mut FeatureHalves,
+    ) {
         let cdiff: [f32; 3] = std::array::from_fn(|c| pa.color[c] - pb.color[c]);
         let va = half_variance(
             (pa.count, pa.color_variance_of_mean()),
@@ -261,10 +272,10 @@ impl Inputs {
         let scale = |k: usize| if k == DEPTH { depth_scale } else { 1.0 };
         for k in 0..FEATURES {
             let s = scale(k);
-            self.features[0].px_mut(i)[k] = pa.features[k] * s;
-            self.features[1].px_mut(i)[k] = pb.features[k] * s;
-            self.features_var[0].px_mut(i)[k] = fa[k] * s * s;
-            self.features_var[1].px_mut(i)[k] = fb[k] * s * s;
+            feats.features[0].px_mut(i)[k] = pa.features[k] * s;
+            feats.features[1].px_mut(i)[k] = pb.features[k] * s;
+            feats.variance[0].px_mut(i)[k] = fa[k] * s * s;
+            feats.variance[1].px_mut(i)[k] = fb[k] * s * s;
         }
         self.hit[i] = pa.features.iter().chain(&pb.features).any(|&f| f != 0.0);
     }
