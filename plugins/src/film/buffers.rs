@@ -3,6 +3,9 @@
 //! index's parity. Each half keeps, per pixel, the count, the running mean and sum of squared
 //! deviations of the colour and of the first-hit features (Welford's form, stable in f32).
 
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
 use crate::first_hit::{Features, FEATURES};
 use crate::space::SamplePoint;
 

@@ -6,6 +6,9 @@
 //! fits are candidates, and each pixel takes the one whose MSE, estimated from the halves,
 //! is lowest, the choice smoothed.
 
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
 mod nlmeans;
 mod planes;
 mod regression;

@@ -4,6 +4,9 @@
 //! patch size costs little per offset), then `exp(-max(0, d))`. Work goes by tiles, each
 //! computed alone, so the result does not depend on the thread count.
 
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
 use super::planes::{by_tiles, Planes, Rect};
 
 /// A single pixel distance beyond this is clamped (Tungsten's), so one channel cannot make
@@ -170,7 +173,7 @@ pub(crate) fn weight(d: f32) -> f32 {
     let g = i - t;
     // 2^g for g in (-1, 0]: its Taylor series in g ln 2.
     let p = 1.0
-        + g * (0.693_147_2
+        + g * (std::f32::consts::LN_2
             + g * (0.240_226_5
                 + g * (0.055_504_1 + g * (0.009_618_13 + g * (0.001_333_36 + g * 0.000_154_04)))));
     f32::from_bits(((127 - i as i32) as u32) << 23) * p

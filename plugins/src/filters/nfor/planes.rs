@@ -1,6 +1,9 @@
 //! Multi-channel f32 images (channels interleaved per pixel) and the filter's inputs read from
 //! the film's half buffers.
 
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
 use crate::film::{HalfPixel, PixelBuffers};
 use crate::first_hit::{DEPTH, FEATURES};
 

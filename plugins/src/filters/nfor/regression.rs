@@ -3,6 +3,9 @@
 //! the pixel's own (a plane in feature space), weighted by NL-means on a guide image. Several
 //! bandwidths share the window's distances.
 
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
 use super::nlmeans::{weight, Guide, Scratch};
 use super::planes::{Planes, Rect, TILE};
 use crate::first_hit::FEATURES;

@@ -4,6 +4,9 @@
 //! always a candidate, its MSE its variance, so that where the noise is below the detail the
 //! choice falls on the pixel itself.
 
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
 use super::nlmeans::{nl_means, Guide};
 use super::planes::Planes;
 
