@@ -122,37 +122,38 @@ impl Regression<'_> {
         };
         let ow = out_rect.w();
         let mut out = vec![0.0f32; out_rect.len() * 4 * nk];
-        let mut near_k: Vec<(usize, f32, [f32; D])> = Vec::with_capacity(offsets.len());
+        // A pixel's neighbours that may weigh in (index, distance, features, colour), and
+        // their weights at the current bandwidth.
+        let mut near: Vec<(usize, f32, [f32; D], [f32; 3])> = Vec::with_capacity(no);
+        let mut wts: Vec<f32> = Vec::with_capacity(no);
         for j in 0..rect.len() {
             let p = (rect.y0 + j / rw) * w + rect.x0 + j % rw;
             let hit = self.hit[p];
             let dist = &dist[j * no..(j + 1) * no];
-            let offsets = &offsets;
-            // The neighbours that weigh in and their distances.
-            let near = || {
-                offsets
-                    .iter()
-                    .enumerate()
-                    .filter_map(move |(o, &(_, step))| {
-                        let d = dist[o];
-                        let q = (p as i64 + step) as usize;
-                        (d != f32::INFINITY && self.hit[q] == hit).then_some((q, d))
-                    })
-            };
+            near.clear();
+            for (o, &(_, step)) in offsets.iter().enumerate() {
+                let d = dist[o];
+                let q = (p as i64 + step) as usize;
+                if d != f32::INFINITY && self.hit[q] == hit {
+                    let y = self.color.px(q);
+                    near.push((q, d, x_of(p, q), [y[0], y[1], y[2]]));
+                }
+            }
             for (k, &s) in inv_k2.iter().enumerate() {
-                // The neighbours that weigh in: index, weight, features.
-                near_k.clear();
-                near_k.extend(near().filter_map(|(q, d)| {
-                    let wt = weight(d * s);
-                    (wt >= MIN_WEIGHT).then(|| (q, wt, x_of(p, q)))
-                }));
+                wts.clear();
+                wts.extend(near.iter().map(|n| weight(n.1 * s)));
                 let mut a: Normal = [[0.0; D]; D + 3];
-                for (q, wt, x) in &near_k {
-                    let y = self.color.px(*q);
-                    accumulate(&mut a, x, &[y[0], y[1], y[2]], *wt);
+                for (n, &wt) in near.iter().zip(&wts) {
+                    if wt >= MIN_WEIGHT {
+                        accumulate(&mut a, &n.2, &n.3, wt);
+                    }
                 }
                 let beta = solve(&a, self.ridge);
-                for (q, wt, x) in &near_k {
+                for (n, &wt) in near.iter().zip(&wts) {
+                    if wt < MIN_WEIGHT {
+                        continue;
+                    }
+                    let (q, x) = (n.0, &n.2);
                     let local = (q / w - out_rect.y0) * ow + q % w - out_rect.x0;
                     let dst = &mut out[(local * nk + k) * 4..][..4];
                     for c in 0..3 {
