@@ -59,6 +59,9 @@ impl Plugins {
     /// the filter needs when the sampler keeps none.
     pub fn film(&self, scene: &crate::scene::Scene) -> Film {
         let mut film = Film::new(scene.film.clone(), self.filter.kernel());
+        if self.filter.reads_pixel_buffers() {
+            film.keep_pixel_buffers();
+        }
         if let Some((cell_size, bins)) = self.filter.cell_layout() {
             let features = self.filter.reads_features();
             if !self.sampler.keeps_cells() || features {
@@ -82,10 +85,17 @@ impl Plugins {
                 },
             )
         };
-        // Two streams: each reconstructed alone, the image their mean.
+        // Two streams: each reconstructed alone, the image their mean; a filter that reads the
+        // half buffers has both streams there.
         self.sampler
             .reconstruct(film)
-            .unwrap_or_else(|| film.per_stream(|f, _| filtered(f)))
+            .unwrap_or_else(|| {
+                if self.filter.reads_pixel_buffers() {
+                    filtered(film)
+                } else {
+                    film.per_stream(|f, _| filtered(f))
+                }
+            })
             .into_iter()
             .map(|c| c * scale)
             .collect()

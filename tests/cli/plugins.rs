@@ -249,6 +249,76 @@ fn the_polynomial_filter_reconstructs_after_any_sampler_and_reports_its_fits() {
     );
 }
 
+#[test]
+fn nfor_reconstructs_after_any_sampler_the_same_on_any_thread_count() {
+    let dir = TempDir::new("nfor");
+    let scene = dir.write("m.pbrt", &example_scene("motion-dof.pbrt", 40, 30));
+    let mean = |img: &[acr::geometry::Spectrum]| {
+        img.iter().map(|c| f64::from(c.x + c.y + c.z)).sum::<f64>()
+    };
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.join(format!("{name}.exr"));
+        let mut args = vec!["--spp", "8"];
+        args.extend_from_slice(extra);
+        render_ok(&scene, &out, &args);
+        read_image(&out, false).unwrap().pixels
+    };
+    let plain = mean(&render(
+        "box",
+        &["--sampler", "stratified", "--filter", "box"],
+    ));
+    for (name, sampler) in [
+        ("stratified", &["--sampler", "stratified"][..]),
+        ("sobol", &["--sampler", "sobol"][..]),
+        ("cluster", &["--sampler", "cluster"][..]),
+        (
+            "streams",
+            &["--sampler", "cluster", "--set", "sampler.streams=2"][..],
+        ),
+    ] {
+        let mut args = sampler.to_vec();
+        args.extend(["--filter", "nfor"]);
+        let img = render(name, &args);
+        assert_eq!(img.len(), 40 * 30);
+        assert!(img.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
+        // The filter moves the image mean by little: within the noise of 8 spp on 1200 pixels.
+        let m = mean(&img);
+        assert!(
+            (m / plain - 1.0).abs() < 0.03,
+            "{name}: mean {m} against box's {plain}"
+        );
+    }
+    let one = render(
+        "one",
+        &[
+            "--sampler",
+            "stratified",
+            "--filter",
+            "nfor",
+            "--threads",
+            "1",
+        ],
+    );
+    let two = render(
+        "two",
+        &[
+            "--sampler",
+            "stratified",
+            "--filter",
+            "nfor",
+            "--threads",
+            "2",
+        ],
+    );
+    assert_eq!(one, two);
+    render_fails(
+        &scene,
+        &dir.join("bad.exr"),
+        &["--filter", "nfor", "--set", "filter.radius=40"],
+        "radius 40 is out of range",
+    );
+}
+
 /// `--aov fitclusters`: the polynomial filter's fitted clusters, as ids per pixel. With the
 /// first-hit features, no cluster straddles the edge between two albedos; a filter that fits
 /// nothing is told so.

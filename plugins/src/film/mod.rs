@@ -11,10 +11,12 @@ use crate::space::SamplePoint;
 use glam::Vec2;
 
 pub use crate::color::{luminance, Spectrum};
+pub use buffers::{HalfPixel, PixelBuffers};
 pub use settings::{FilmSettings, MAX_PIXELS, MAX_RESOLUTION};
 use splat::{Prepared, Splat, TABLE_SIZE};
 pub use stats::{relative_error_of, PixelStats};
 
+mod buffers;
 mod settings;
 mod splat;
 mod stats;
@@ -38,6 +40,8 @@ pub struct Film {
     halves: Option<Box<[Film; 2]>>,
     /// The first stream's weight in the image, when split (the second's is 1 minus it).
     first_weight: f64,
+    /// Per-pixel half buffers, for a filter that reads them ([`Film::keep_pixel_buffers`]).
+    buffers: Option<Box<PixelBuffers>>,
 }
 
 impl Film {
@@ -68,7 +72,22 @@ impl Film {
             located: Vec::new(),
             halves: None,
             first_weight: 0.5,
+            buffers: None,
         }
+    }
+
+    /// Makes the film keep each pixel's two halves of samples (by index parity) with their
+    /// colour and first-hit features ([`PixelBuffers`]); the render loop then computes the
+    /// features of every sample. Called before any sample is added.
+    pub fn keep_pixel_buffers(&mut self) {
+        let [cx0, _, cy0, _] = self.settings.crop;
+        let (w, h) = self.settings.size();
+        self.buffers = Some(Box::new(PixelBuffers::new(w, h, [cx0, cy0])));
+    }
+
+    /// The per-pixel half buffers, when kept.
+    pub fn pixel_buffers(&self) -> Option<&PixelBuffers> {
+        self.buffers.as_deref()
     }
 
     /// Keeps the two sample streams of a paired sampler apart (a sample's stream is its
@@ -80,7 +99,10 @@ impl Film {
         if self.halves.is_some() {
             return;
         }
+        // The half buffers stay here: they hold both streams already.
+        let buffers = self.buffers.take();
         let half = self.clone();
+        self.buffers = buffers;
         // The splats and cells live in the halves only.
         self.cells = None;
         self.sums = Vec::new();
@@ -145,6 +167,11 @@ impl Film {
         radiance: &[[f32; 3]],
         features: Option<&[Features]>,
     ) {
+        if let Some(b) = self.buffers.as_mut() {
+            b.add(batch, radiance, features);
+        }
+        // The cells see features only when they keep them.
+        let features = features.filter(|_| self.cells_keep_features());
         if let Some(h) = self.halves.as_mut() {
             // Each stream's points to its own film's cells, in order.
             for (s, half) in h.iter_mut().enumerate() {
@@ -164,10 +191,16 @@ impl Film {
         sums.add_batch(&self.located, radiance, features);
     }
 
-    /// Whether the film's cells keep the samples' first-hit features ([`Film::collect_cells`]).
+    /// Whether the film needs the samples' first-hit features: its cells keep them
+    /// ([`Film::collect_cells`]) or it keeps half buffers ([`Film::keep_pixel_buffers`]).
     pub fn collects_features(&self) -> bool {
+        self.buffers.is_some() || self.cells_keep_features()
+    }
+
+    /// Whether the film's cells (or its streams' cells) keep first-hit features.
+    fn cells_keep_features(&self) -> bool {
         if let Some(h) = &self.halves {
-            return h[0].collects_features();
+            return h[0].cells_keep_features();
         }
         self.cells
             .as_ref()
@@ -302,6 +335,7 @@ impl Film {
     pub fn release_sums(&mut self) {
         self.sums = Vec::new();
         self.halves = None;
+        self.buffers = None;
     }
 
     /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's

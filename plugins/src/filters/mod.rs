@@ -4,6 +4,7 @@
 mod boxf;
 mod gaussian;
 mod mitchell;
+mod nfor;
 mod polynomial;
 mod sinc;
 mod triangle;
@@ -11,6 +12,7 @@ mod triangle;
 pub use boxf::BoxFilter;
 pub use gaussian::GaussianFilter;
 pub use mitchell::MitchellFilter;
+pub use nfor::NforFilter;
 pub use polynomial::PolynomialFilter;
 pub use sinc::LanczosSincFilter;
 pub use triangle::TriangleFilter;
@@ -51,6 +53,13 @@ pub trait Filter: Send + Sync {
     /// Whether the filter reads the samples' first-hit features from the film's cells: the
     /// film then collects cells with them, whatever the sampler keeps.
     fn reads_features(&self) -> bool {
+        false
+    }
+
+    /// Whether the filter reads the film's per-pixel half buffers ([`Film::keep_pixel_buffers`]):
+    /// the film then keeps them, with every sample's first-hit features, and the filter is
+    /// given the whole film even when the sampler's streams are split.
+    fn reads_pixel_buffers(&self) -> bool {
         false
     }
 
@@ -185,6 +194,7 @@ pub static FILTERS: &[Entry<FilterBuild>] = &[
     mitchell::ENTRY,
     sinc::ENTRY,
     polynomial::ENTRY,
+    nfor::ENTRY,
 ];
 
 /// Doc of the `xwidth` parameter every pbrt-v3 filter has.

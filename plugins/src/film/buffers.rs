@@ -1,0 +1,147 @@
+//! Per-pixel half buffers for a reconstruction that estimates its own error from two
+//! independent halves of the samples (NFOR, docs/reconstruction.md): a sample's half is its
+//! index's parity. Each half keeps, per pixel, the count, the running mean and sum of squared
+//! deviations of the colour and of the first-hit features (Welford's form, stable in f32).
+
+// Small fixed-size channel and matrix loops read clearest with indices.
+#![allow(clippy::needless_range_loop)]
+
+use crate::first_hit::{Features, FEATURES};
+use crate::space::SamplePoint;
+
+/// One half's statistics for one pixel: 88 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HalfPixel {
+    /// Samples in this half.
+    pub count: u32,
+    /// Mean colour.
+    pub color: [f32; 3],
+    /// Sum of squared deviations of the colour from its mean.
+    pub color_m2: [f32; 3],
+    /// Mean first-hit features.
+    pub features: Features,
+    /// Sum of squared deviations of the features from their mean.
+    pub features_m2: Features,
+}
+
+impl HalfPixel {
+    /// Adds one sample.
+    #[inline]
+    fn add(&mut self, l: [f32; 3], f: &Features) {
+        self.count += 1;
+        let inv = 1.0 / self.count as f32;
+        for c in 0..3 {
+            let delta = l[c] - self.color[c];
+            self.color[c] += delta * inv;
+            self.color_m2[c] += delta * (l[c] - self.color[c]);
+        }
+        for k in 0..FEATURES {
+            let delta = f[k] - self.features[k];
+            self.features[k] += delta * inv;
+            self.features_m2[k] += delta * (f[k] - self.features[k]);
+        }
+    }
+
+    /// The variance of this half's mean colour, per channel: the sample variance over the
+    /// count (None with fewer than two samples).
+    pub fn color_variance_of_mean(&self) -> Option<[f32; 3]> {
+        (self.count >= 2).then(|| {
+            let n = self.count as f32;
+            self.color_m2.map(|m2| m2.max(0.0) / ((n - 1.0) * n))
+        })
+    }
+
+    /// The variance of this half's mean features (None with fewer than two samples).
+    pub fn features_variance_of_mean(&self) -> Option<Features> {
+        (self.count >= 2).then(|| {
+            let n = self.count as f32;
+            self.features_m2.map(|m2| m2.max(0.0) / ((n - 1.0) * n))
+        })
+    }
+}
+
+/// Both halves of every pixel of the cropped film, row-major.
+#[derive(Clone, Debug)]
+pub struct PixelBuffers {
+    width: u32,
+    height: u32,
+    /// The raster origin of the crop.
+    origin: [u32; 2],
+    halves: [Vec<HalfPixel>; 2],
+}
+
+impl PixelBuffers {
+    /// Empty buffers for a `width` x `height` crop starting at raster `origin`.
+    pub fn new(width: u32, height: u32, origin: [u32; 2]) -> Self {
+        let n = width as usize * height as usize;
+        Self {
+            width,
+            height,
+            origin,
+            halves: [vec![HalfPixel::default(); n], vec![HalfPixel::default(); n]],
+        }
+    }
+
+    /// The crop's size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Half `h`'s pixels (0 or 1), row-major.
+    pub fn half(&self, h: usize) -> &[HalfPixel] {
+        &self.halves[h & 1]
+    }
+
+    /// Adds the samples of a batch: each point's radiance (NaN: dropped, skipped) and
+    /// first-hit features (zeros when not given) to its pixel's half, in order.
+    pub fn add(
+        &mut self,
+        batch: &[SamplePoint],
+        radiance: &[[f32; 3]],
+        features: Option<&[Features]>,
+    ) {
+        let (w, h) = (self.width as i64, self.height as i64);
+        for (k, (q, l)) in batch.iter().zip(radiance).enumerate() {
+            if l[0].is_nan() {
+                continue;
+            }
+            let x = q.film[0].floor() as i64 - i64::from(self.origin[0]);
+            let y = q.film[1].floor() as i64 - i64::from(self.origin[1]);
+            if x < 0 || y < 0 || x >= w || y >= h {
+                continue;
+            }
+            let f = features.map_or([0.0; FEATURES], |f| f[k]);
+            self.halves[q.index as usize & 1][(y * w + x) as usize].add(*l, &f);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_go_to_their_index_parity() {
+        let mut b = PixelBuffers::new(2, 1, [10, 5]);
+        let mut batch = Vec::new();
+        for i in 0..4 {
+            batch.push(SamplePoint {
+                index: i,
+                film: [11.5, 5.5],
+                pixel: [11, 5],
+                ..SamplePoint::UNMADE
+            });
+        }
+        let radiance = [[1.0; 3], [2.0; 3], [3.0; 3], [f32::NAN; 3]];
+        let features = [[0.5; FEATURES]; 4];
+        b.add(&batch, &radiance, Some(&features));
+        assert_eq!(b.half(0)[1].count, 2);
+        assert_eq!(b.half(0)[1].color, [2.0; 3]);
+        assert_eq!(b.half(1)[1].count, 1);
+        assert_eq!(b.half(1)[1].color, [2.0; 3]);
+        assert_eq!(b.half(0)[0].count, 0);
+        let v = b.half(0)[1].color_variance_of_mean().expect("two samples");
+        assert!((v[0] - 1.0).abs() < 1e-6, "{v:?}");
+        assert_eq!(b.half(0)[1].features, [0.5; FEATURES]);
+    }
+}
