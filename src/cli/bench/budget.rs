@@ -30,13 +30,14 @@ fn equal_time_spp(spp: u32, baseline: Option<f64>, own: Option<f64>) -> u32 {
 pub(super) struct Spent {
     /// Render plus reconstruction seconds.
     pub(super) render: f64,
-    /// The command's seconds (0 without one).
+    /// The seconds after the render's time limit: the reconstruction's plus an external
+    /// method's command's.
     pub(super) command: f64,
 }
 
 /// A compared run's spp and time limit: at equal spp the budget; at equal time the first
 /// method's seconds at this budget (`baseline`, an error where it failed) less what the
-/// method's command took in its own equal-spp run, as the render's limit, with the spp that
+/// method's reconstruction and command took in its own equal-spp run, as the render's limit, with the spp that
 /// `time_limited_spp` names or that the method's own render seconds (`own`) say fit. An
 /// external method (`external`) without its own run cannot know its command's cost: an error.
 pub(super) fn run_budget(
@@ -58,8 +59,8 @@ pub(super) fn run_budget(
     let limit = baseline - command;
     if limit <= 0.0 {
         return Err(format!(
-            "its command took {command:.3} s, no less than the first method's {baseline:.3} s: \
-             no time is left to render"
+            "its reconstruction and command took {command:.3} s, no less than the first method's \
+             {baseline:.3} s: no time is left to render"
         ));
     }
     let spp = budgets

@@ -28,6 +28,8 @@ pub(super) fn command_input(output: &Path) -> PathBuf {
 pub(super) struct RunOutput {
     /// Render plus reconstruction seconds.
     pub(super) seconds: f64,
+    /// The reconstruction's share of `seconds`.
+    pub(super) reconstruct_seconds: f64,
     /// Samples traced.
     pub(super) samples: u64,
     /// Pixels of the image.
@@ -155,6 +157,7 @@ impl RenderRun<'_> {
             seconds: r.seconds + command_seconds.unwrap_or(0.0),
             command_seconds,
             command_time: command.map(|_| self.method.time.unwrap_or_default()),
+            reconstruct_seconds: r.reconstruct_seconds,
             samples: r.samples,
             spp_reached: r.samples as f64 / r.pixels.max(1) as f64,
             metrics,
@@ -185,6 +188,7 @@ fn read_stats(stats: &Path, sampler_cost: bool) -> Result<RunOutput, String> {
     Ok(RunOutput {
         cost,
         seconds: f("render") + f("reconstruct"),
+        reconstruct_seconds: f("reconstruct"),
         samples: v["samples"].as_u64().unwrap_or(0),
         pixels: v["width"].as_u64().unwrap_or(0) * v["height"].as_u64().unwrap_or(0),
         peak_rss_mb: v["peak_rss_mb"].as_f64().unwrap_or(0.0),

@@ -32,6 +32,9 @@ pub struct Measured {
     pub command_seconds: Option<f64>,
     /// How that share was counted.
     pub command_time: Option<CommandTime>,
+    /// The reconstruction's share of `seconds` (after the render's time limit, like a
+    /// command's).
+    pub reconstruct_seconds: f64,
     /// Samples taken.
     pub samples: u64,
     /// Samples per pixel reached.
@@ -97,6 +100,7 @@ impl Measured {
                 .sum::<Option<f64>>()
                 .map(|t| t / n),
             command_time: runs.first().and_then(|r| r.command_time),
+            reconstruct_seconds: mean(|r| r.reconstruct_seconds),
             samples: mean(|r| r.samples as f64).round() as u64,
             spp_reached: mean(|r| r.spp_reached),
             metrics: Metrics {

@@ -236,10 +236,12 @@ impl<'a> Bench<'a> {
             }
             if mode == Mode::EqualSpp {
                 times.own[i] = outcome.as_ref().ok().map(|r| {
-                    let command = r.command_seconds.unwrap_or(0.0);
+                    // What runs after the render's time limit: the reconstruction and a
+                    // command (docs/BENCHMARKS.md, "Equal time").
+                    let after = r.command_seconds.unwrap_or(0.0) + r.reconstruct_seconds;
                     Spent {
-                        render: r.seconds - command,
-                        command,
+                        render: r.seconds - after,
+                        command: after,
                     }
                 });
             }
