@@ -65,6 +65,30 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_filters_estimate_is_taken_else_each_pixels_variance_of_the_mean() {
+        use crate::film::{FilmSettings, Spectrum};
+        use crate::filters::BoxFilter;
+        use glam::Vec2;
+        let mut f = Film::new(
+            FilmSettings::with_resolution(2, 1),
+            &BoxFilter::new(0.5, 0.5),
+        );
+        // Pixel 0: samples 1 and 3 (variance 2, of the mean 1); pixel 1: one sample.
+        f.add_sample(Vec2::new(0.25, 0.5), Spectrum::splat(1.0));
+        f.add_sample(Vec2::new(0.75, 0.5), Spectrum::splat(3.0));
+        f.add_sample(Vec2::new(1.5, 0.5), Spectrum::splat(5.0));
+        let own = ErrorMap::of(&f, None);
+        assert_eq!((own.width, own.height), (2, 1));
+        assert!((own.error[0] - 1.0).abs() < 1e-6, "{:?}", own.error);
+        assert_eq!(own.error[1], 0.0);
+        // The filter's, cleaned of NaN and negatives.
+        let given = ErrorMap::of(&f, Some(vec![f32::NAN, 0.5]));
+        assert_eq!(given.error, [0.0, 0.5]);
+        // One of the wrong size is not the film's: the film's own instead.
+        assert_eq!(ErrorMap::of(&f, Some(vec![7.0])), own);
+    }
+
+    #[test]
     fn outside_pixels_take_the_nearest_estimate() {
         let m = ErrorMap {
             x0: 2,
