@@ -10,7 +10,7 @@ use crate::integrator::{Integrator, Radiance};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
 use acr_plugins::first_hit::{sanitized, Features};
-use acr_plugins::sampler::{IndexStream, SOBOL_DIMS_USED};
+use acr_plugins::sampler::{ErrorMap, IndexStream, SOBOL_DIMS_USED};
 use acr_plugins::{Film, RenderingSpace, SamplePoint, Sampler};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -97,6 +97,28 @@ pub struct Stop<'a> {
     /// in the time left at the speed so far ([`Sampler::plan_for`]), so that an adaptive
     /// sampler plans its stages for the time rather than for its budget.
     pub plan_to_time: bool,
+    /// The reconstruction's estimate of each pixel's squared error from the film as it
+    /// stands ([`acr_plugins::Filter::estimated_error`]), for a sampler that asks for one
+    /// ([`Sampler::wants_guidance`]); without it, or where it gives none, the sampler gets
+    /// each pixel's variance of the mean.
+    pub estimated_error: Option<&'a ErrorEstimate<'a>>,
+}
+
+/// A reconstruction's per-pixel estimate of its squared error from a film, if it makes one.
+pub type ErrorEstimate<'a> = dyn Fn(&Film) -> Option<Vec<f32>> + Sync + 'a;
+
+/// Hands `sampler` the estimated error of each pixel when it asks, the film holding every
+/// batch it gave (the render loop calls it only when no batch is in flight).
+fn answer_guidance(
+    sampler: &mut dyn Sampler,
+    film: &Film,
+    estimate: Option<&ErrorEstimate<'_>>,
+    in_sampler: &mut Duration,
+) {
+    if sampler.wants_guidance() {
+        let map = ErrorMap::of(film, estimate.and_then(|e| e(film)));
+        timed(in_sampler, || sampler.guide(&map));
+    }
 }
 
 impl Stop<'_> {
@@ -372,6 +394,9 @@ pub fn render_with(
             None => {
                 traced.hand_over(sampler, film, &mut in_sampler);
                 pending = false;
+                // A sampler that asks for guidance plans nothing ahead meanwhile: the film
+                // now holds every batch it gave.
+                answer_guidance(sampler, film, stop.estimated_error, &mut in_sampler);
                 more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
             }
         }

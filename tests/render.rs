@@ -672,3 +672,63 @@ fn the_cluster_sampler_sums_radiance_in_its_cells_only_for_a_filter_that_reads_t
         );
     }
 }
+
+/// The render loop hands a guided sampler the filter's estimate of each pixel's error: given
+/// one that is large on the left half of the image and nil on the right, the rounds go left.
+#[test]
+fn the_render_loop_hands_a_guided_sampler_the_filters_estimate() {
+    use acr::render::{render_with_features, Stop};
+    use acr_plugins::Film;
+    let mut desc = parse_file(&root().join("scenes/cornell-box.pbrt")).unwrap();
+    set_resolution(&mut desc, 32, 24);
+    let mut warnings = Vec::new();
+    let scene = Scene::build(&desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+    let overrides = Overrides {
+        sampler: Some("cluster".into()),
+        filter: Some("gaussian".into()),
+        integrator: None,
+        settings: vec![acr_plugins::Setting::parse("sampler.guide=reconstruction").unwrap()],
+    };
+    let mut plugins = choose_for_scene(&desc, &scene, &overrides, Some(16), 1, &mut warnings)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut film = plugins.film(&scene);
+    let asked = std::sync::atomic::AtomicU32::new(0);
+    let estimate = |f: &Film| {
+        asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let (w, h) = f.settings().size();
+        Some(
+            (0..w * h)
+                .map(|i| if i % w < w / 2 { 1.0 } else { 0.0 })
+                .collect(),
+        )
+    };
+    let stop = Stop {
+        estimated_error: Some(&estimate),
+        ..Stop::default()
+    };
+    render_with_features(
+        &scene,
+        &plugins.integrator,
+        plugins.sampler.as_mut(),
+        &mut film,
+        1,
+        &stop,
+        None,
+        None,
+    );
+    assert_eq!(asked.load(std::sync::atomic::Ordering::Relaxed), 1);
+    let (left, right) =
+        film.pixel_stats()
+            .iter()
+            .enumerate()
+            .fold((0u64, 0u64), |(l, r), (i, s)| {
+                if i % 32 < 16 {
+                    (l + u64::from(s.count), r)
+                } else {
+                    (l, r + u64::from(s.count))
+                }
+            });
+    // 4 first-stage samples a pixel on each side; the right keeps about those.
+    assert!(left > 3 * right, "{left} samples left, {right} right");
+    assert_eq!(left + right, 32 * 24 * 16);
+}

@@ -56,6 +56,14 @@ impl Sampler for Recording<'_> {
         self.inner.halt();
     }
 
+    fn wants_guidance(&self) -> bool {
+        self.inner.wants_guidance()
+    }
+
+    fn guide(&mut self, error: &acr_plugins::sampler::ErrorMap) {
+        self.inner.guide(error);
+    }
+
     fn plans_ahead(&self) -> bool {
         self.inner.plans_ahead()
     }

@@ -5,6 +5,7 @@
 mod awr;
 mod cluster;
 mod gem;
+mod guide;
 mod halton;
 mod mdas;
 mod paired;
@@ -15,6 +16,7 @@ mod sobol;
 mod stratified;
 
 pub use cluster::{ClusterSampler, ClusterSettings, Priority};
+pub use guide::ErrorMap;
 pub use halton::HaltonSampler;
 pub(crate) use pixel_pattern::{next_batch_where, PixelCursor, PixelPattern};
 pub use pixel_rounds::PixelMoments;
@@ -106,6 +108,21 @@ pub trait Sampler: Send {
     fn plan_for(&mut self, spp: u32) -> bool {
         let _ = spp;
         false
+    }
+
+    /// Whether it asks, before its next batch, for the reconstruction's estimate of each
+    /// pixel's error ([`Sampler::guide`]): the render loop asks before every batch and answers
+    /// once every batch given is in the film. A sampler that asks does not plan ahead
+    /// ([`Sampler::plans_ahead`]) meanwhile. By default, never.
+    fn wants_guidance(&self) -> bool {
+        false
+    }
+
+    /// The reconstruction's estimated squared error of each pixel from the film as it stands
+    /// (or the variance of each pixel's mean where the filter makes no estimate), which it
+    /// asked for ([`Sampler::wants_guidance`]). By default, ignored.
+    fn guide(&mut self, error: &ErrorMap) {
+        let _ = error;
     }
 
     /// Whether the next batch may be asked for before the last one is observed (so that it is

@@ -67,7 +67,10 @@ pub(super) fn render_scene(
     };
     let write_partial = |film: &Film, seconds: f64| looks.write_partial(film, seconds);
     let show = |film: &Film, _: f64| looks.show(film);
-    let stop = stop_rules(args, &interrupted, &write_partial, &show, &looks);
+    let filter = &job.plugins.filter;
+    let estimate = |f: &Film| filter.estimated_error(f);
+    let mut stop = stop_rules(args, &interrupted, &write_partial, &show, &looks);
+    stop.estimated_error = Some(&estimate);
     let mut features = target.aovs.iter().any(AovRequest::is_feature).then(|| {
         let [x0, x1, y0, y1] = job.scene.film.crop;
         FeatureImage::new(x0, x1, y0, y1)
@@ -174,6 +177,7 @@ fn stop_rules<'a>(
         plan_to_time: args.time_plan == TimePlan::Fit,
         interrupt: Some(interrupted),
         checkpoints,
+        estimated_error: None,
     }
 }
 

@@ -113,7 +113,12 @@ impl Crossed {
     /// (`first_unobserved(other)`), when the other can go instead.
     fn next_half(&self, first_unobserved: impl Fn(usize) -> bool) -> Option<usize> {
         let live = |h: usize| !self.done[h] && self.halves[h].state.phase != Phase::Done;
-        let waits = |h: usize| self.halves[h].about_to_cluster() && first_unobserved(1 - h);
+        // Guided, a half about to cluster also waits for the map, which needs both halves'
+        // first stages.
+        let waits = |h: usize| {
+            let half = &self.halves[h];
+            half.about_to_cluster() && (first_unobserved(1 - h) || half.awaits_guide())
+        };
         let order = [self.turn, 1 - self.turn];
         order
             .into_iter()
@@ -207,7 +212,21 @@ impl Sampler for Crossed {
         true
     }
 
+    fn wants_guidance(&self) -> bool {
+        // Once both first stages are in the film.
+        self.given.is_empty() && self.halves.iter().all(ClusterSampler::awaits_guide)
+    }
+
+    fn guide(&mut self, error: &crate::sampler::ErrorMap) {
+        for h in &mut self.halves {
+            h.take_guide(error);
+        }
+    }
+
     fn plans_ahead(&self) -> bool {
+        if self.halves.iter().any(ClusterSampler::awaits_guide) {
+            return false;
+        }
         // Asked ahead, the batch traced meanwhile is the only one unobserved at the call.
         let traced = self.given.back().copied();
         let first_unobserved = |g: usize| traced == Some((g, true));

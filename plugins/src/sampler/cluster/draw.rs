@@ -43,6 +43,7 @@ impl ClusterSampler {
         let round_key = mix64(self.seed ^ SALT ^ mix64(self.state.rounds));
         let (grid, space) = (&self.state.grid, &self.space);
         let colour = self.settings.colour;
+        let pairs = self.settings.guided;
         let groups: Vec<Vec<u64>> = picks
             .par_chunks(PICKS_PER_TASK)
             .enumerate()
@@ -60,7 +61,9 @@ impl ClusterSampler {
                 for (n, (&(_, k), cells)) in group.iter().zip(&lists).enumerate() {
                     let stream = (g * PICKS_PER_TASK + n) as u64;
                     let mut rng = Pcg32::new(round_key, stream);
-                    for slot in Self::slots(&mut rng, cells.len(), k) {
+                    // Guided, each pixel drawn takes two consecutive indices.
+                    let copies = if pairs { 2 } else { 1 };
+                    for slot in Self::slots(&mut rng, cells.len(), k / copies) {
                         let cell = cells[slot] as usize;
                         let pixel = match per_pixel {
                             Some(per) => grid.pixel_of_cell(cell, per),
@@ -77,7 +80,9 @@ impl ClusterSampler {
                             None => (col, row),
                         };
                         // Row and column packed, so that sorting needs no division.
-                        drawn.push(u64::from(row) << 32 | u64::from(col));
+                        for _ in 0..copies {
+                            drawn.push(u64::from(row) << 32 | u64::from(col));
+                        }
                     }
                 }
                 drawn

@@ -22,6 +22,7 @@ use rayon::prelude::*;
 
 mod crossed;
 mod draw;
+mod guided;
 mod noise;
 mod plan;
 mod scratch;
@@ -98,6 +99,9 @@ impl ClusterSampler {
             rounds: 0,
             partition: None,
             noise: None,
+            guide: None,
+            cell_error: Vec::new(),
+            first_per_cell: 0.0,
         };
         Self {
             settings,
@@ -146,6 +150,7 @@ impl ClusterSampler {
         let clustering = initial.clustering;
         self.state.version = vec![0; clustering.clusters.len()];
         self.state.clustering = Some(clustering);
+        self.weigh_by_guide();
         let n = self.state.version.len() as u32;
         self.state.push_all(self.settings.priority, 0..n);
     }
@@ -153,9 +158,14 @@ impl ClusterSampler {
     /// Plans the next round into `out`: clusters by priority, a few samples each, until the
     /// round holds its share of what is left.
     fn plan_round(&mut self, out: &mut Vec<SamplePoint>) {
-        let target = (self.state.remaining / 16)
+        let mut target = (self.state.remaining / 16)
             .clamp(MIN_ROUND, BATCH_SAMPLES)
             .min(self.state.remaining);
+        // Guided, samples go in pairs.
+        let pairs = self.settings.guided;
+        if pairs {
+            target &= !1;
+        }
         let Round {
             cells,
             mut picked,
@@ -187,16 +197,19 @@ impl ClusterSampler {
             if self.settings.settle && self.state.noise.is_some_and(settled) {
                 continue;
             }
-            let k = u64::from(top.cells)
+            let mut k = u64::from(top.cells)
                 .clamp(CLUSTER_SAMPLES.0, CLUSTER_SAMPLES.1)
                 .min(target - planned_total);
+            if pairs {
+                k &= !1;
+            }
             picks.push((top.id, k));
             picked.push(top);
             planned_total += k;
             top.samples += k;
             let priority = state::priority(self.settings.priority, &top);
             match self.settings.priority {
-                Priority::PerSample => self.state.queue.push(priority, top),
+                Priority::PerSample | Priority::Guided => self.state.queue.push(priority, top),
                 // The paper's rule takes each cluster once per round, by largest error.
                 Priority::Paper => deferred.push((priority, top)),
             }
@@ -407,6 +420,14 @@ impl Sampler for ClusterSampler {
         let floor = self.init_floor();
         self.plan_budget(spp, floor);
         true
+    }
+
+    fn wants_guidance(&self) -> bool {
+        self.awaits_guide()
+    }
+
+    fn guide(&mut self, error: &crate::sampler::ErrorMap) {
+        self.take_guide(error);
     }
 
     fn plans_ahead(&self) -> bool {

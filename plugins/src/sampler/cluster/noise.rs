@@ -16,6 +16,9 @@ impl ClusterSampler {
         if unstarted && !self.settings.init_given {
             let s = &mut self.settings;
             s.init_spp = s.init_spp.min(min_spp.max(s.min_spp)).clamp(1, s.spp);
+            if s.guided {
+                s.init_spp = super::guided::even_up(s.init_spp, s.spp);
+            }
             self.state.init =
                 SobolSampler::new(self.space, s.init_spp, self.seed ^ SALT).with_stream(s.stream);
             self.state.remaining = self.adaptive_budget();

@@ -31,7 +31,10 @@ impl ClusterSampler {
             } else {
                 first_stage_spp(spp, lowest)
             };
-            let init = share.max(s.min_spp).max(floor).min(s.init_spp);
+            let mut init = share.max(s.min_spp).max(floor).min(s.init_spp);
+            if s.guided {
+                init = super::guided::even_up(init, s.init_spp);
+            }
             self.settings.init_spp = self.state.init.cursor_mut().shorten(init);
         }
         let planned = self.own_pixels() * u64::from(spp.saturating_sub(self.settings.init_spp));

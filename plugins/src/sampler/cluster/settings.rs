@@ -17,6 +17,10 @@ pub enum Priority {
     PerSample,
     /// The paper's rule: the largest err(Ω).
     Paper,
+    /// By the reconstruction's estimated error (`guide "reconstruction"`): the cluster's
+    /// summed error at the end of the first stage times its samples then, over its samples
+    /// squared: what one more sample takes off an error that falls as one over the samples.
+    Guided,
 }
 
 /// The cluster sampler's knobs (docs/plugins.md; `acr plugins` lists them with their defaults).
@@ -66,6 +70,10 @@ pub struct ClusterSettings {
     /// `crossed.rs`); a sample drawn at a pixel of the other colour goes to its partner
     /// pixel in the same row (or column). `None`: every pixel.
     pub colour: Option<u32>,
+    /// Place the rounds by the reconstruction's estimated error, read once after the first
+    /// stage (`guide "reconstruction"`, see `guided.rs`), each pixel's samples in pairs of
+    /// consecutive indices.
+    pub guided: bool,
 }
 
 impl ClusterSettings {
@@ -102,6 +110,7 @@ impl ClusterSettings {
             init_given: false,
             settle: false,
             colour: None,
+            guided: false,
         }
     }
 
@@ -228,6 +237,15 @@ pub(in crate::sampler) const ENTRY: Entry<SamplerBuild> = Entry {
                  only (a checkerboard of two halves), so that no pixel's count depends on its \
                  own values and the image mean is unbiased",
             ),
+            ParamSpec::new(
+                "guide",
+                ParamType::String,
+                "none",
+                "none, or reconstruction: after the first stage the rounds go to the clusters \
+                 of largest summed estimated error of the reconstruction (the filter's own \
+                 estimate, else each pixel's variance of the mean), read once, each pixel's \
+                 samples in pairs of consecutive indices; see docs/cluster-sampler.md",
+            ),
             crate::sampler::paired::STREAMS,
             crate::sampler::paired::PILOT,
         ],
@@ -260,6 +278,11 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
         let message = "unbiased cannot be combined with a pilot or two streams";
         return Err(error_at_param(p, &["unbiased"], "cluster sampler", message));
     }
+    s.guided = one_of(p, "guide", &["none", "reconstruction"])? == 1;
+    if s.guided && !whole {
+        let message = "guide cannot be combined with a pilot or two streams";
+        return Err(error_at_param(p, &["guide"], "cluster sampler", message));
+    }
     if unbiased {
         // Decisions read the first stage alone: two samples per pixel at least, so that each
         // cell has a variance (measured at 4 spp: MSE 0.70x and 0.76x that of one sample on
@@ -267,6 +290,10 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
         s.init_spp = (spp / 4).max(2).min(spp);
     }
     s.init_spp = int_in(p, "initspp", s.init_spp as i32, 1..=max)?;
+    if s.guided {
+        // Every pixel's count even, so that its two halves (index parities) match.
+        s.init_spp = super::guided::even_up(s.init_spp, spp);
+    }
     s.init_given = p.get("initspp").is_some();
     s.settle = p.bool_or("settle", s.settle)?;
     s.min_spp = int_in(p, "minspp", s.min_spp as i32, 0..=max)?;

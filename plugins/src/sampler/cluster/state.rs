@@ -11,7 +11,7 @@ use crate::cells::queue::{BucketQueue, Queued};
 use crate::cells::{CellGrid, CellSums, Clustering, FeatureScale};
 use crate::film::relative_error_of;
 use crate::partition::Partition;
-use crate::sampler::SobolSampler;
+use crate::sampler::{ErrorMap, SobolSampler};
 use crate::space::RenderingSpace;
 use std::collections::VecDeque;
 
@@ -92,6 +92,14 @@ pub(super) struct State {
     /// With `--noise-threshold`: the threshold, and the samples each cell of a cluster needs
     /// before the cluster may settle.
     pub noise: Option<(f64, u32)>,
+    /// The reconstruction's estimated error after the first stage, when guided and handed
+    /// over, until the clustering reads it.
+    pub guide: Option<ErrorMap>,
+    /// Guided: each cell's estimated error after the first stage (empty otherwise).
+    pub cell_error: Vec<f64>,
+    /// Guided: the first stage's samples per cell of the pixels whose counts it decides
+    /// (fewer in a half of an unbiased pair, which decides half the pixels).
+    pub first_per_cell: f64,
 }
 
 /// The sampling priority of a queued cluster under `rule`.
@@ -99,6 +107,10 @@ pub(super) fn priority(rule: Priority, e: &Queued) -> f64 {
     match rule {
         Priority::Paper => e.weight,
         Priority::PerSample => e.weight / e.samples.max(1) as f64,
+        Priority::Guided => {
+            let n = e.samples.max(1) as f64;
+            e.weight / (n * n)
+        }
     }
 }
 
@@ -129,6 +141,11 @@ impl State {
                 let mean = c.mean();
                 let err = c.err() + mean[0].abs() + mean[1].abs() + clustering.rule.tolerance;
                 err * c.cells.len() as f64
+            }
+            Priority::Guided => {
+                // Its error as the samples it began with would leave it, times them.
+                let error: f64 = c.cells.iter().map(|&i| self.cell_error[i as usize]).sum();
+                error * self.first_per_cell * c.cells.len() as f64
             }
         };
         let e = Queued {

@@ -320,6 +320,7 @@ fn bad_knobs_are_located_errors() {
         ("sampler.initspp=99", "initspp 99 is out of range"),
         ("sampler.cellsize=100", "cellsize 100 is out of range"),
         ("sampler.priority=most", "priority \"most\" is not known"),
+        ("sampler.guide=most", "guide \"most\" is not known"),
     ] {
         let mut c = Choice::new(None, "cluster", None);
         Setting::parse(arg)
@@ -387,4 +388,72 @@ fn a_noise_threshold_shrinks_the_first_stage_and_settled_clusters_get_no_more() 
     let mut s = ClusterSampler::new(space(0, 0, w, h, ALL_DIMS[0]), settings, 7);
     s.stop_at_noise(0.05, 2);
     assert_eq!(s.settings().init_spp, 4);
+}
+
+#[test]
+fn guided_rounds_follow_the_error_map_in_pairs_read_once_after_the_first_stage() {
+    use crate::registry::Setting;
+    use crate::sampler::ErrorMap;
+    let (w, h) = (64, 48);
+    let setup = SamplerSetup {
+        space: space(0, 0, w, h, ALL_DIMS[1]),
+        spp: Some(12),
+        seed: 3,
+        reconstruction_reads_cells: false,
+        stream: Default::default(),
+    };
+    let mut c = Choice::new(None, "cluster", None);
+    Setting::parse("sampler.guide=reconstruction")
+        .expect("guide")
+        .apply(&ENTRY.info, &mut c)
+        .expect("guide");
+    // The unbiased pair, by default.
+    let mut s = build(&c, &setup).expect("guided");
+    // Large error right of x = 32, small left of it.
+    let map = ErrorMap {
+        x0: 0,
+        y0: 0,
+        width: w,
+        height: h,
+        error: (0..w * h)
+            .map(|i| if i % w >= 32 { 1.0 } else { 0.01 })
+            .collect(),
+    };
+    // The render loop's order without planning ahead: each batch observed, then guidance
+    // when asked, then the next batch.
+    let (mut all, mut batch) = (Vec::new(), Vec::new());
+    let mut asked_at = Vec::new();
+    while s.next_batch(&mut batch) {
+        let r: Vec<[f32; 3]> = batch.iter().map(half_noisy).collect();
+        s.observe(&batch, &r);
+        all.extend_from_slice(&batch);
+        if s.wants_guidance() {
+            asked_at.push(all.len());
+            s.guide(&map);
+            assert!(!s.wants_guidance(), "asks again once answered");
+        }
+    }
+    // Asked once, when the first stage (12 / 4 = 3 samples per pixel, made even: 4) was all
+    // given.
+    assert_eq!(asked_at, [(w * h * 4) as usize]);
+    assert_eq!(all.len() as u32, w * h * 12);
+    let sorted = crate::sampler::tests::by_pixel(&setup.space, &[all]);
+    let mut n = vec![0u32; (w * h) as usize];
+    for q in &sorted {
+        let k = (q.pixel[1] * w + q.pixel[0]) as usize;
+        // Each pixel's indices 0, 1, 2, ... once each.
+        assert_eq!(q.index, n[k]);
+        n[k] += 1;
+    }
+    // Pairs: both index parities of every pixel equally many.
+    assert!(n.iter().all(|&k| k >= 4 && k % 2 == 0), "{n:?}");
+    let n = &n;
+    let mean = |cols: std::ops::Range<u32>| {
+        let total: u32 = (0..h)
+            .flat_map(|y| cols.clone().map(move |x| n[(y * w + x) as usize]))
+            .sum();
+        f64::from(total) / f64::from(cols.len() as u32 * h)
+    };
+    let (low, high) = (mean(0..30), mean(34..64));
+    assert!(high > 2.0 * low, "{high} against {low}");
 }
