@@ -17,7 +17,8 @@ use crate::cells::grid::MAX_DIMS;
 use crate::sampler::ErrorMap;
 
 /// The guided first stage's least count per pixel: two samples in each half (index parity),
-/// so that each half has a variance of its own when the estimate is read.
+/// so that each half has a variance of its own when the estimate is read (from a budget of
+/// twice this on).
 pub(super) const FIRST_STAGE_MIN: u32 = 4;
 
 /// `v` rounded up to an even count, at most `spp` (an odd budget keeps an odd first stage

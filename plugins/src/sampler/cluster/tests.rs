@@ -491,6 +491,9 @@ fn guided_first_stage_gives_each_half_two_samples_before_the_estimate_is_read() 
     assert_eq!(guided(8, None), 4);
     assert_eq!(guided(16, None), 4);
     assert_eq!(guided(32, None), 8);
+    // Below 8 the quarter (at least 2) stays, leaving half the budget or more for rounds.
+    assert_eq!(guided(4, None), 2);
+    assert_eq!(guided(6, None), 2);
     // A first stage given explicitly is kept (made even).
     assert_eq!(guided(8, Some("sampler.initspp=2")), 2);
 }
