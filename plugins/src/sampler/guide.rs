@@ -1,8 +1,8 @@
 //! What the render loop hands a sampler that places samples by the reconstruction's estimated
 //! error (docs/cluster-sampler.md, "Guided by the reconstruction's error"): a per-pixel map of
 //! the estimated squared error, from the filter when it makes one
-//! ([`crate::filters::Filter::estimated_error`]), else from the film's own statistics (the
-//! variance of each pixel's mean luminance).
+//! ([`crate::filters::Filter::estimated_error`]) floored at the film's own statistics (the
+//! variance of each pixel's mean luminance), else from those statistics alone.
 
 use crate::film::{luminance, Film};
 
@@ -22,18 +22,23 @@ pub struct ErrorMap {
 }
 
 impl ErrorMap {
-    /// The map of `film`'s cropped pixels: `estimate` (a filter's, row-major over the cropped
-    /// film) when it has one value per pixel, else the variance of each pixel's mean luminance.
+    /// The map of `film`'s cropped pixels: the variance of each pixel's mean luminance, raised
+    /// to `estimate` (a filter's, row-major over the cropped film, when it has one value per
+    /// pixel) where that is larger.
     pub fn of(film: &Film, estimate: Option<Vec<f32>>) -> Self {
         let [x0, x1, y0, y1] = film.settings().crop;
         let pixels = (x1 - x0) as usize * (y1 - y0) as usize;
-        let error = match estimate {
-            Some(e) if e.len() == pixels => e,
-            _ => film
-                .pixel_stats()
-                .iter()
-                .map(|s| luminance(s.variance_of_mean()))
-                .collect(),
+        let own = film
+            .pixel_stats()
+            .iter()
+            .map(|s| luminance(s.variance_of_mean()));
+        // A filter's estimate of its error (NFOR's: the halves' differences less their
+        // variances, clamped) is zero wherever its own noise swamps it, most pixels after a
+        // short first stage, and those pixels would get no rounds; the variance of the mean,
+        // what their samples would take off, is the floor (docs/cluster-sampler.md).
+        let error: Vec<f32> = match estimate {
+            Some(e) if e.len() == pixels => own.zip(e).map(|(v, e)| v.max(e)).collect(),
+            _ => own.collect(),
         };
         Self {
             x0,
@@ -65,7 +70,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_filters_estimate_is_taken_else_each_pixels_variance_of_the_mean() {
+    fn the_filters_estimate_is_floored_at_each_pixels_variance_of_the_mean() {
         use crate::film::{FilmSettings, Spectrum};
         use crate::filters::BoxFilter;
         use glam::Vec2;
@@ -81,9 +86,18 @@ mod tests {
         assert_eq!((own.width, own.height), (2, 1));
         assert!((own.error[0] - 1.0).abs() < 1e-6, "{:?}", own.error);
         assert_eq!(own.error[1], 0.0);
-        // The filter's, cleaned of NaN and negatives.
-        let given = ErrorMap::of(&f, Some(vec![f32::NAN, 0.5]));
-        assert_eq!(given.error, [0.0, 0.5]);
+        // The filter's where larger, NaN and negatives cleaned; the variance of the mean
+        // where the filter's is smaller (pixel 0) or says nothing.
+        let given = ErrorMap::of(&f, Some(vec![0.25, 0.5]));
+        assert_eq!(given.error, [1.0, 0.5]);
+        assert_eq!(
+            ErrorMap::of(&f, Some(vec![f32::NAN, -1.0])).error,
+            [1.0, 0.0]
+        );
+        assert_eq!(
+            ErrorMap::of(&f, Some(vec![3.0, f32::NAN])).error,
+            [3.0, 0.0]
+        );
         // One of the wrong size is not the film's: the film's own instead.
         assert_eq!(ErrorMap::of(&f, Some(vec![7.0])), own);
     }

@@ -16,6 +16,11 @@ use super::{ClusterSampler, Phase, PixelPattern, Priority};
 use crate::cells::grid::MAX_DIMS;
 use crate::sampler::ErrorMap;
 
+/// The guided first stage's least count per pixel: two samples in each half (index parity),
+/// so that each half has a variance of its own when the estimate is read (from a budget of
+/// twice this on).
+pub(super) const FIRST_STAGE_MIN: u32 = 4;
+
 /// `v` rounded up to an even count, at most `spp` (an odd budget keeps an odd first stage
 /// only when it is the whole budget).
 pub(super) fn even_up(v: u32, spp: u32) -> u32 {

@@ -289,6 +289,16 @@ pub(super) fn build(c: &Choice, setup: &SamplerSetup) -> Result<Box<dyn Sampler>
         // motion-blur and depth-of-field).
         s.init_spp = (spp / 4).max(2).min(spp);
     }
+    if s.guided {
+        // The estimate is read at the end of the first stage from each half's own variance:
+        // two samples per half at least, else a reconstruction such as NFOR estimates its
+        // error from one difference per pixel, mostly noise (docs/cluster-sampler.md, "Guided
+        // by the reconstruction's error"). Below twice that budget it would leave no rounds
+        // for the map to guide worth the name: the quarter stays.
+        if spp >= 2 * super::guided::FIRST_STAGE_MIN {
+            s.init_spp = s.init_spp.max(super::guided::FIRST_STAGE_MIN);
+        }
+    }
     s.init_spp = int_in(p, "initspp", s.init_spp as i32, 1..=max)?;
     if s.guided {
         // Every pixel's count even, so that its two halves (index parities) match.

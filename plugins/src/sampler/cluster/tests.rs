@@ -457,3 +457,43 @@ fn guided_rounds_follow_the_error_map_in_pairs_read_once_after_the_first_stage()
     let (low, high) = (mean(0..30), mean(34..64));
     assert!(high > 2.0 * low, "{high} against {low}");
 }
+
+#[test]
+fn guided_first_stage_gives_each_half_two_samples_before_the_estimate_is_read() {
+    use crate::registry::Setting;
+    let guided = |spp: u32, extra: Option<&str>| {
+        let setup = SamplerSetup {
+            space: space(0, 0, 16, 16, ALL_DIMS[1]),
+            spp: Some(spp),
+            seed: 3,
+            reconstruction_reads_cells: false,
+            stream: Default::default(),
+        };
+        let mut c = Choice::new(None, "cluster", None);
+        for text in std::iter::once("sampler.guide=reconstruction").chain(extra) {
+            let set = Setting::parse(text).expect("setting");
+            set.apply(&ENTRY.info, &mut c).expect("setting");
+        }
+        let mut s = build(&c, &setup).expect("guided");
+        // The first stage is what is given before the sampler first asks for the map.
+        let (mut given, mut batch) = (0usize, Vec::new());
+        while s.next_batch(&mut batch) {
+            let r: Vec<[f32; 3]> = batch.iter().map(half_noisy).collect();
+            s.observe(&batch, &r);
+            given += batch.len();
+            if s.wants_guidance() {
+                return given / 256;
+            }
+        }
+        panic!("never asked for the map");
+    };
+    // A quarter of 8 would be one sample per half.
+    assert_eq!(guided(8, None), 4);
+    assert_eq!(guided(16, None), 4);
+    assert_eq!(guided(32, None), 8);
+    // Below 8 the quarter (at least 2) stays, leaving half the budget or more for rounds.
+    assert_eq!(guided(4, None), 2);
+    assert_eq!(guided(6, None), 2);
+    // A first stage given explicitly is kept (made even).
+    assert_eq!(guided(8, Some("sampler.initspp=2")), 2);
+}
