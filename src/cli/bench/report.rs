@@ -200,7 +200,7 @@ fn write_setting(s: &mut String, m: &Manifest, manifest: &Path, opts: &BenchOpti
     }
     let _ = writeln!(
         s,
-        "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds as `--time-limit` (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
+        "- seconds: render + reconstruction of each run (its stats file); ratios are against `{}`, the first method (below 1 is better); equal time: each method given the spp its own equal-spp run says fits in the first method's seconds at that budget (at most 4x), and those seconds less its reconstruction's (and a command's) seconds in that run as `--time-limit`, since the limit stops the sampling and the reconstruction comes after (it stops at the end of the pass under way, so its time can overshoot by up to one pass)\n",
         m.methods[0].label
     );
     write_external_notes(s, m);
