@@ -150,7 +150,7 @@ impl NforFilter {
             hit,
         };
         let sel = select(&candidates, &mses, &smoothing);
-        drop(candidates);
+        drop((candidates, mses));
         let [ra, rb] = &sel.halves;
         let first = ra.map(3, |i, a, o| {
             for c in 0..3 {

@@ -75,6 +75,7 @@ pub(crate) fn select(
         }
     }
     let smooth = nl_means(&stack, smoothing.guide, smoothing.radius, smoothing.hit);
+    drop(stack);
     let mut choice = Planes::new(w, h, nc);
     for i in 0..n {
         let m = smooth.px(i);
@@ -82,6 +83,7 @@ pub(crate) fn select(
         choice.px_mut(i)[best] = 1.0;
     }
     let weights = nl_means(&choice, smoothing.guide, smoothing.radius, smoothing.hit);
+    drop(choice);
     let mut out = [Planes::new(w, h, 3), Planes::new(w, h, 3)];
     let mut mse = vec![0.0f32; n];
     for i in 0..n {
