@@ -126,18 +126,29 @@ impl NforFilter {
             reg.run(guide, ks)
         });
         let [fa, fb] = fits;
-        let mut candidates = vec![Candidate {
-            halves: inp.color.clone(),
-        }];
-        for (a, b) in fa.into_iter().zip(fb) {
-            candidates.push(Candidate { halves: [a, b] });
+        let fitted: Vec<[Planes; 2]> = fa.into_iter().zip(fb).map(|(a, b)| [a, b]).collect();
+        // The second pass regresses on the halves' mean features: the halves' own are done
+        // with, and go before the choice's planes are made.
+        let features = second.then(|| {
+            prefiltered[0].map(FEATURES, |i, a, o| {
+                for (k, o) in o.iter_mut().enumerate() {
+                    *o = 0.5 * (a[k] + prefiltered[1].px(i)[k]);
+                }
+            })
+        });
+        drop(prefiltered);
+        let [c0, c1] = &inp.color;
+        let candidates: Vec<Candidate> = std::iter::once(Candidate { halves: [c0, c1] })
+            .chain(fitted.iter().map(|[a, b]| Candidate { halves: [a, b] }))
+            .collect();
+        // Each candidate's estimated MSE, one channel each. The unfiltered mean's is its
+        // variance, weighed by MEAN_MSE_FACTOR.
+        let mut stack = Planes::new(inp.full.w, inp.full.h, candidates.len());
+        for i in 0..inp.full_var.w * inp.full_var.h {
+            stack.px_mut(i)[0] = inp.full_var.px(i).iter().sum::<f32>() / 3.0 * MEAN_MSE_FACTOR;
         }
-        // The unfiltered mean's MSE is its variance, weighed by MEAN_MSE_FACTOR.
-        let mut mses = vec![(0..inp.full_var.w * inp.full_var.h)
-            .map(|i| inp.full_var.px(i).iter().sum::<f32>() / 3.0 * MEAN_MSE_FACTOR)
-            .collect::<Vec<f32>>()];
-        for c in &candidates[1..] {
-            mses.push(candidate_mse(c, &inp.color, &inp.color_var));
+        for (col, c) in candidates.iter().enumerate().skip(1) {
+            candidate_mse(c, &inp.color, &inp.color_var, &mut stack, col);
         }
         let smoothing = Smoothing {
             guide: Guide {
@@ -149,22 +160,18 @@ impl NforFilter {
             radius: self.select_radius,
             hit,
         };
-        let sel = select(&candidates, &mses, &smoothing);
-        drop((candidates, mses));
+        let sel = select(&candidates, stack, &smoothing);
+        drop(candidates);
+        drop(fitted);
         let [ra, rb] = &sel.halves;
         let first = ra.map(3, |i, a, o| {
             for c in 0..3 {
                 o[c] = 0.5 * (a[c] + rb.px(i)[c]);
             }
         });
-        if !second {
+        let Some(features) = features else {
             return (first, sel.mse);
-        }
-        let features = prefiltered[0].map(FEATURES, |i, a, o| {
-            for (k, o) in o.iter_mut().enumerate() {
-                *o = 0.5 * (a[k] + prefiltered[1].px(i)[k]);
-            }
-        });
+        };
         let image = self.second_pass(&inp, &sel, &first, &features);
         (image, sel.mse)
     }
