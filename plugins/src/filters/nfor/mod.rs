@@ -20,7 +20,7 @@ use crate::first_hit::FEATURES;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use acr_parser::{ParamType, Result};
 use nlmeans::{nl_means, Guide};
-use planes::{Inputs, Planes};
+use planes::{FeatureHalves, Inputs, Planes};
 use regression::Regression;
 use selection::{candidate_mse, select, Candidate, Selected, Smoothing};
 
@@ -97,7 +97,7 @@ impl NforFilter {
         let hit = &inp.hit;
         // Features prefiltered across the halves: each half's features averaged with
         // weights from the other half's.
-        let prefiltered = [0, 1].map(|h| {
+        let prefilter = |feats: &FeatureHalves, h: usize| {
             let guide = Guide {
                 image: &feats.features[1 - h],
                 variance: &feats.variance[1 - h],
@@ -105,7 +105,12 @@ impl NforFilter {
                 k2: PREFILTER_K * PREFILTER_K,
             };
             nl_means(&feats.features[h], guide, self.prefilter_radius, hit)
-        });
+        };
+        let mut feats = feats;
+        let first_half = prefilter(&feats, 0);
+        // Half 1's variance guided half 0 only: gone before half 1's planes are made.
+        feats.variance[1] = Planes::new(0, 0, FEATURES);
+        let prefiltered = [first_half, prefilter(&feats, 1)];
         drop(feats);
         // Each half fitted on the other half's prefiltered features with weights from the
         // other half's colour (Tungsten's crossing).
