@@ -20,7 +20,7 @@ use crate::first_hit::FEATURES;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use acr_parser::{ParamType, Result};
 use nlmeans::{nl_means, Guide};
-use planes::{Inputs, Planes};
+use planes::{FeatureHalves, Inputs, Planes};
 use regression::Regression;
 use selection::{candidate_mse, select, Candidate, Selected, Smoothing};
 
@@ -97,7 +97,7 @@ impl NforFilter {
         let hit = &inp.hit;
         // Features prefiltered across the halves: each half's features averaged with
         // weights from the other half's.
-        let prefiltered = [0, 1].map(|h| {
+        let prefilter = |feats: &FeatureHalves, h: usize| {
             let guide = Guide {
                 image: &feats.features[1 - h],
                 variance: &feats.variance[1 - h],
@@ -105,7 +105,12 @@ impl NforFilter {
                 k2: PREFILTER_K * PREFILTER_K,
             };
             nl_means(&feats.features[h], guide, self.prefilter_radius, hit)
-        });
+        };
+        let mut feats = feats;
+        let first_half = prefilter(&feats, 0);
+        // Half 1's variance guided half 0 only: gone before half 1's planes are made.
+        feats.variance[1] = Planes::new(0, 0, FEATURES);
+        let prefiltered = [first_half, prefilter(&feats, 1)];
         drop(feats);
         // Each half fitted on the other half's prefiltered features with weights from the
         // other half's colour (Tungsten's crossing).
@@ -126,18 +131,29 @@ impl NforFilter {
             reg.run(guide, ks)
         });
         let [fa, fb] = fits;
-        let mut candidates = vec![Candidate {
-            halves: inp.color.clone(),
-        }];
-        for (a, b) in fa.into_iter().zip(fb) {
-            candidates.push(Candidate { halves: [a, b] });
+        let fitted: Vec<[Planes; 2]> = fa.into_iter().zip(fb).map(|(a, b)| [a, b]).collect();
+        // The second pass regresses on the halves' mean features: the halves' own are done
+        // with, and go before the choice's planes are made.
+        let features = second.then(|| {
+            prefiltered[0].map(FEATURES, |i, a, o| {
+                for (k, o) in o.iter_mut().enumerate() {
+                    *o = 0.5 * (a[k] + prefiltered[1].px(i)[k]);
+                }
+            })
+        });
+        drop(prefiltered);
+        let [c0, c1] = &inp.color;
+        let candidates: Vec<Candidate> = std::iter::once(Candidate { halves: [c0, c1] })
+            .chain(fitted.iter().map(|[a, b]| Candidate { halves: [a, b] }))
+            .collect();
+        // Each candidate's estimated MSE, one channel each. The unfiltered mean's is its
+        // variance, weighed by MEAN_MSE_FACTOR.
+        let mut stack = Planes::new(inp.full.w, inp.full.h, candidates.len());
+        for i in 0..inp.full_var.w * inp.full_var.h {
+            stack.px_mut(i)[0] = inp.full_var.px(i).iter().sum::<f32>() / 3.0 * MEAN_MSE_FACTOR;
         }
-        // The unfiltered mean's MSE is its variance, weighed by MEAN_MSE_FACTOR.
-        let mut mses = vec![(0..inp.full_var.w * inp.full_var.h)
-            .map(|i| inp.full_var.px(i).iter().sum::<f32>() / 3.0 * MEAN_MSE_FACTOR)
-            .collect::<Vec<f32>>()];
-        for c in &candidates[1..] {
-            mses.push(candidate_mse(c, &inp.color, &inp.color_var));
+        for (col, c) in candidates.iter().enumerate().skip(1) {
+            candidate_mse(c, &inp.color, &inp.color_var, &mut stack, col);
         }
         let smoothing = Smoothing {
             guide: Guide {
@@ -149,22 +165,18 @@ impl NforFilter {
             radius: self.select_radius,
             hit,
         };
-        let sel = select(&candidates, &mses, &smoothing);
+        let sel = select(&candidates, stack, &smoothing);
         drop(candidates);
+        drop(fitted);
         let [ra, rb] = &sel.halves;
         let first = ra.map(3, |i, a, o| {
             for c in 0..3 {
                 o[c] = 0.5 * (a[c] + rb.px(i)[c]);
             }
         });
-        if !second {
+        let Some(features) = features else {
             return (first, sel.mse);
-        }
-        let features = prefiltered[0].map(FEATURES, |i, a, o| {
-            for (k, o) in o.iter_mut().enumerate() {
-                *o = 0.5 * (a[k] + prefiltered[1].px(i)[k]);
-            }
-        });
+        };
         let image = self.second_pass(&inp, &sel, &first, &features);
         (image, sel.mse)
     }

@@ -85,24 +85,26 @@ pub(crate) fn by_tiles(
 ) -> Planes {
     use rayon::prelude::*;
     let (tw, th) = (w.div_ceil(TILE), h.div_ceil(TILE));
-    let tiles: Vec<(Rect, Vec<f32>)> = (0..tw * th)
-        .into_par_iter()
-        .map(|t| {
-            let (tx, ty) = (t % tw, t / tw);
-            let r = Rect {
-                x0: tx * TILE,
-                x1: ((tx + 1) * TILE).min(w),
-                y0: ty * TILE,
-                y1: ((ty + 1) * TILE).min(h),
-            };
-            (r, tile(r))
-        })
-        .collect();
     let mut out = Planes::new(w, h, c);
-    for (r, vals) in tiles {
-        let rw = r.w() * c;
-        for (j, y) in (r.y0..r.y1).enumerate() {
-            out.data[(y * w + r.x0) * c..][..rw].copy_from_slice(&vals[j * rw..][..rw]);
+    // One row of tiles at a time, so that only that row's results are held besides the image.
+    for ty in 0..th {
+        let tiles: Vec<(Rect, Vec<f32>)> = (0..tw)
+            .into_par_iter()
+            .map(|tx| {
+                let r = Rect {
+                    x0: tx * TILE,
+                    x1: ((tx + 1) * TILE).min(w),
+                    y0: ty * TILE,
+                    y1: ((ty + 1) * TILE).min(h),
+                };
+                (r, tile(r))
+            })
+            .collect();
+        for (r, vals) in tiles {
+            let rw = r.w() * c;
+            for (j, y) in (r.y0..r.y1).enumerate() {
+                out.data[(y * w + r.x0) * c..][..rw].copy_from_slice(&vals[j * rw..][..rw]);
+            }
         }
     }
     out

@@ -12,9 +12,8 @@ use crate::first_hit::FEATURES;
 
 /// Unknowns of the fit: the intercept and one slope per feature.
 const D: usize = 1 + FEATURES;
-/// The normal equations of one fit: rows 0..D the normal matrix, kept whole (not the
-/// triangle) so that each row's update is one vector operation, rows D..D + 3 the three
-/// channels' right-hand sides.
+/// The normal equations of one fit: rows 0..D the normal matrix (its lower triangle only:
+/// the solve reads no other), rows D..D + 3 the three channels' right-hand sides.
 type Normal = [[f32; D]; D + 3];
 
 /// Weights below this add nothing measurable and are skipped.
@@ -47,27 +46,29 @@ impl Regression<'_> {
         let guide = Guide { k2: 1.0, ..guide };
         let inv_k2: Vec<f32> = ks.iter().map(|k| 1.0 / (k * k)).collect();
         let (tw, th) = (w.div_ceil(TILE), h.div_ceil(TILE));
-        let tiles: Vec<(Rect, Vec<f32>)> = (0..tw * th)
-            .into_par_iter()
-            .map(|t| {
-                let (tx, ty) = (t % tw, t / tw);
-                let rect = Rect {
-                    x0: tx * TILE,
-                    x1: ((tx + 1) * TILE).min(w),
-                    y0: ty * TILE,
-                    y1: ((ty + 1) * TILE).min(h),
-                };
-                self.tile(guide, &inv_k2, rect)
-            })
-            .collect();
-        // Per pixel, per bandwidth: the predictions' weighted sums and their weight.
+        // Per pixel, per bandwidth: the predictions' weighted sums and their weight. One row
+        // of tiles at a time, so that only that row's tiles are held besides the sums.
         let mut sums = Planes::new(w, h, 4 * nk);
-        for (r, vals) in tiles {
-            let rw = r.w() * 4 * nk;
-            for (j, y) in (r.y0..r.y1).enumerate() {
-                let dst = &mut sums.data[(y * w + r.x0) * 4 * nk..][..rw];
-                for (d, v) in dst.iter_mut().zip(&vals[j * rw..][..rw]) {
-                    *d += v;
+        for ty in 0..th {
+            let tiles: Vec<(Rect, Vec<f32>)> = (0..tw)
+                .into_par_iter()
+                .map(|tx| {
+                    let rect = Rect {
+                        x0: tx * TILE,
+                        x1: ((tx + 1) * TILE).min(w),
+                        y0: ty * TILE,
+                        y1: ((ty + 1) * TILE).min(h),
+                    };
+                    self.tile(guide, &inv_k2, rect)
+                })
+                .collect();
+            for (r, vals) in tiles {
+                let rw = r.w() * 4 * nk;
+                for (j, y) in (r.y0..r.y1).enumerate() {
+                    let dst = &mut sums.data[(y * w + r.x0) * 4 * nk..][..rw];
+                    for (d, v) in dst.iter_mut().zip(&vals[j * rw..][..rw]) {
+                        *d += v;
+                    }
                 }
             }
         }
@@ -174,7 +175,7 @@ fn accumulate(a: &mut Normal, x: &[f32; D], y: &[f32; 3], wt: f32) {
     let (gram, rhs) = a.split_at_mut(D);
     for i in 0..D {
         let wx = wt * x[i];
-        for j in 0..D {
+        for j in 0..=i {
             gram[i][j] += wx * x[j];
         }
     }
@@ -201,7 +202,7 @@ fn solve(a: &Normal, ridge: f32) -> [[f32; D]; 3] {
     });
     let mut m = [[0.0f64; D]; D];
     for (i, row) in m.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate().take(i + 1) {
             *v = f64::from(a[i][j]);
         }
     }

@@ -11,22 +11,25 @@ use super::nlmeans::{nl_means, Guide};
 use super::planes::Planes;
 
 /// One candidate: its filtering of each half.
-pub(crate) struct Candidate {
-    pub halves: [Planes; 2],
+pub(crate) struct Candidate<'a> {
+    pub halves: [&'a Planes; 2],
 }
 
-/// The estimated MSE (mean over the channels) of the mean of a candidate's two halves:
+/// The estimated MSE (mean over the channels) of the mean of a candidate's two halves, into
+/// channel `col` of `out`:
 /// each half's squared difference from the other half less that half's variance, averaged,
 /// less the variance the averaging removes (NFOR's estimate, as Tungsten computes it).
 pub(crate) fn candidate_mse(
     c: &Candidate,
     halves: &[Planes; 2],
     half_var: &[Planes; 2],
-) -> Vec<f32> {
-    let [fa, fb] = &c.halves;
+    out: &mut Planes,
+    col: usize,
+) {
+    let [fa, fb] = c.halves;
     let [a, b] = halves;
-    (0..a.w * a.h)
-        .map(|i| {
+    for i in 0..a.w * a.h {
+        out.px_mut(i)[col] = {
             let mut s = 0.0;
             for ch in 0..3 {
                 let ma = (b.px(i)[ch] - fa.px(i)[ch]).powi(2) - half_var[1].px(i)[ch];
@@ -35,8 +38,8 @@ pub(crate) fn candidate_mse(
                 s += 0.5 * (ma + mb) - resid;
             }
             s / 3.0
-        })
-        .collect()
+        };
+    }
 }
 
 /// How the choice is smoothed: the guide (the pixel means and their variance), the window
@@ -58,23 +61,18 @@ pub(crate) struct Selected {
 }
 
 /// The per-pixel blend of the candidates (each half), and its estimated MSE: the raw MSE maps
-/// `mses` (one per candidate) are smoothed, each pixel picks the lowest, and the one-hot
+/// `stack` (one channel per candidate) are smoothed, each pixel picks the lowest, and the one-hot
 /// choice maps are smoothed into blend weights.
 pub(crate) fn select(
     candidates: &[Candidate],
-    mses: &[Vec<f32>],
+    stack: Planes,
     smoothing: &Smoothing<'_>,
 ) -> Selected {
     let nc = candidates.len();
     let (w, h) = (candidates[0].halves[0].w, candidates[0].halves[0].h);
     let n = w * h;
-    let mut stack = Planes::new(w, h, nc);
-    for i in 0..n {
-        for (c, m) in mses.iter().enumerate() {
-            stack.px_mut(i)[c] = m[i];
-        }
-    }
     let smooth = nl_means(&stack, smoothing.guide, smoothing.radius, smoothing.hit);
+    drop(stack);
     let mut choice = Planes::new(w, h, nc);
     for i in 0..n {
         let m = smooth.px(i);
@@ -82,6 +80,7 @@ pub(crate) fn select(
         choice.px_mut(i)[best] = 1.0;
     }
     let weights = nl_means(&choice, smoothing.guide, smoothing.radius, smoothing.hit);
+    drop(choice);
     let mut out = [Planes::new(w, h, 3), Planes::new(w, h, 3)];
     let mut mse = vec![0.0f32; n];
     for i in 0..n {
