@@ -76,6 +76,52 @@ pub const TABLE: [Row; 4] = [
     },
 ];
 
+/// The pipeline once the time limit leaves room for NFOR's reconstruction, whatever the dims:
+/// `bench/denoise.toml`, three seeds, at the time stratified+box takes at 64 spp (where nfor
+/// took about a quarter of the time) cluster+nfor had 0.38x, 0.27x, 0.29x, 0.095x and 0.081x of
+/// stratified+box's MSE on the five scenes, against cluster+polynomial's 0.43x, 0.50x, 0.51x,
+/// 0.20x and 0.12x; at the time of 16 spp (nfor about half the time or more) it lost to
+/// cluster+polynomial on four of five.
+pub const NFOR_ROW: Row = Row {
+    time: false,
+    lens: false,
+    sampler: "cluster",
+    filter: "nfor",
+    settings: &[SPP_CAP],
+    measured: "docs/BENCHMARKS.md, \"Against Open Image Denoise\": at the time of 64 \
+               stratified+box spp, cluster+nfor 0.38x / 0.27x / 0.29x / 0.095x / 0.081x of \
+               stratified+box against cluster+polynomial's 0.43x / 0.50x / 0.51x / 0.20x / \
+               0.12x",
+};
+
+/// nfor's reconstruction, in thread-seconds per pixel: 0.36 to 0.40 s for 76,800 pixels on 2
+/// threads in the bench run (docs/reconstruction.md, "NFOR", cost).
+const NFOR_THREAD_SECONDS_PER_PIXEL: f64 = 1.0e-5;
+
+/// The largest share of the time limit nfor's reconstruction may take for the auto pipeline to
+/// choose it: it won at about a quarter, lost at a half (`NFOR_ROW`).
+const NFOR_MAX_SHARE: f64 = 0.3;
+
+/// nfor's estimated reconstruction seconds for `pixels` on `threads`.
+pub fn nfor_seconds(pixels: u64, threads: u32) -> f64 {
+    pixels as f64 * NFOR_THREAD_SECONDS_PER_PIXEL / f64::from(threads.max(1))
+}
+
+/// The row for a render of `dims`, `pixels` on `threads`, stopped at `time_limit` seconds (if
+/// any): nfor's once its reconstruction fits in [`NFOR_MAX_SHARE`] of the limit, else the
+/// table's.
+pub fn row_for_time(
+    dims: Dims,
+    time_limit: Option<f64>,
+    pixels: u64,
+    threads: u32,
+) -> &'static Row {
+    match time_limit {
+        Some(t) if nfor_seconds(pixels, threads) <= NFOR_MAX_SHARE * t => &NFOR_ROW,
+        _ => row_for(dims),
+    }
+}
+
 /// The row for a scene of dimensions `dims`.
 pub fn row_for(dims: Dims) -> &'static Row {
     TABLE
@@ -92,7 +138,12 @@ pub(super) fn choose(
     args: &RenderArgs,
     desc: &SceneDescription,
     dims: Dims,
+    pixels: u64,
 ) -> Result<Option<&'static Row>, String> {
+    let threads = args.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, |n| n.get() as u32)
+    });
+    let row_for = |dims| row_for_time(dims, args.time_limit, pixels, threads);
     let named_here = args.sampler.is_some() || args.filter.is_some();
     match args.pipeline {
         Some(Pipeline::Scene) => Ok(None),
@@ -118,8 +169,26 @@ pub(super) fn stats_name(row: Option<&Row>) -> String {
     }
 }
 
+/// The seconds an auto pipeline's render leaves its reconstruction out of the time limit: the
+/// limit stops the sampling, and the best image in the time is the reconstructed one.
+pub(super) fn reserve(row: Option<&Row>, pixels: u64, threads: u32) -> f64 {
+    match row {
+        Some(r) if r.filter == "nfor" => nfor_seconds(pixels, threads),
+        _ => 0.0,
+    }
+}
+
 /// What stderr says of an auto pipeline: the row and where its measurement is.
 pub(super) fn announce(row: &Row) -> String {
+    if row.filter == "nfor" {
+        let source = row.measured.split(':').next().unwrap_or(row.measured);
+        return format!(
+            "acr: pipeline auto: {} + {}: the time limit leaves room for its reconstruction, \
+             measured best at equal time ({source}); --pipeline scene renders with the \
+             scene's sampler and filter",
+            row.sampler, row.filter
+        );
+    }
     let dims = match (row.time, row.lens) {
         (false, false) => "no motion blur, no lens",
         (true, false) => "motion blur",
@@ -137,6 +206,25 @@ pub(super) fn announce(row: &Row) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nfor_is_chosen_once_the_limit_leaves_room_for_its_reconstruction() {
+        let dims = Dims {
+            time: true,
+            lens: false,
+        };
+        // 76,800 pixels on 2 threads: about 0.38 s of reconstruction.
+        let px = 320 * 240;
+        assert_eq!(row_for_time(dims, Some(1.5), px, 2).filter, "nfor");
+        assert_eq!(row_for_time(dims, Some(0.6), px, 2).filter, "polynomial");
+        assert_eq!(row_for_time(dims, None, px, 2), row_for(dims));
+        // Four times the pixels want four times the time.
+        assert_eq!(row_for_time(dims, Some(1.5), 4 * px, 2).filter, "polynomial");
+        assert!((reserve(Some(&NFOR_ROW), px, 2) - 0.384).abs() < 1e-9);
+        assert_eq!(reserve(Some(row_for(dims)), px, 2), 0.0);
+        let names: Vec<&str> = crate::registry::all().map(|i| i.name).collect();
+        assert!(names.contains(&NFOR_ROW.filter));
+    }
 
     #[test]
     fn every_combination_of_dims_has_one_row_of_known_plugins() {

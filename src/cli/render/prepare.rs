@@ -52,7 +52,8 @@ impl Job {
         let spp = if args.quick { Some(1) } else { args.spp };
         let mut warnings = desc.warnings.clone();
         let scene = build_scene(args, &desc, &mut warnings)?;
-        let auto = pipeline::choose(args, &desc, scene.dims)?;
+        let (w, h) = scene.film.size();
+        let auto = pipeline::choose(args, &desc, scene.dims, u64::from(w) * u64::from(h))?;
         let overrides = overrides(args, auto)?;
         let mut plugins =
             choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)

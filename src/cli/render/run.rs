@@ -70,6 +70,13 @@ pub(super) fn render_scene(
     let filter = &job.plugins.filter;
     let estimate = |f: &Film| filter.estimated_error(f);
     let mut stop = stop_rules(args, &interrupted, &write_partial, &show, &looks);
+    if let Some(limit) = stop.time_limit {
+        // An auto pipeline's reconstruction comes out of the limit (docs/cli.md).
+        let (w, h) = job.scene.film.size();
+        let threads = rayon::current_num_threads() as u32;
+        let reserve = super::pipeline::reserve(job.pipeline, u64::from(w) * u64::from(h), threads);
+        stop.time_limit = Some(limit.saturating_sub(Duration::from_secs_f64(reserve)));
+    }
     stop.estimated_error = Some(&estimate);
     let mut features = target.aovs.iter().any(AovRequest::is_feature).then(|| {
         let [x0, x1, y0, y1] = job.scene.film.crop;
