@@ -3,7 +3,7 @@
 //! the scene's dims and says so on stderr and in the stats.
 
 use super::*;
-use acr::cli::render::{row_for, Row};
+use acr::cli::render::{row_for, Row, NFOR_ROW};
 use acr_plugins::Dims;
 
 /// The stats and stderr of rendering `scene` with `args`.
@@ -24,8 +24,15 @@ fn a_time_limit_or_noise_threshold_with_nothing_named_renders_the_auto_pipeline(
     let dir = TempDir::new("pipeline-auto");
     // No Sampler, no PixelFilter, nothing moves, no lens.
     let scene = dir.write("s.pbrt", &small_scene(""));
-    let row = row_for(Dims::default());
-    for stop in [["--time-limit", "30"], ["--noise-threshold", "0.5"]] {
+    let dims_row = row_for(Dims::default());
+    // A limit that leaves room for nfor's reconstruction takes the nfor row; a limit that
+    // does not, and a noise threshold, the dims' row.
+    let cases = [
+        (["--time-limit", "30"], &NFOR_ROW),
+        (["--time-limit", "0.0001"], dims_row),
+        (["--noise-threshold", "0.5"], dims_row),
+    ];
+    for (stop, row) in cases {
         let (s, err) = run(&dir, &scene, &[stop[0], stop[1], "--spp", "4"]);
         assert_eq!(s["pipeline"], auto_name(row), "{stop:?}");
         assert_eq!(s["sampler"], row.sampler, "{stop:?}");

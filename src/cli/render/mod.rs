@@ -14,7 +14,7 @@ mod sampler_cost;
 mod target;
 
 pub use args::{Pipeline, RenderArgs, TimePlan};
-pub use pipeline::{row_for, Row, TABLE};
+pub use pipeline::{row_for, Row, NFOR_ROW, TABLE};
 
 use prepare::Job;
 use run::Rendered;
