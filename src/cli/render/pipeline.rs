@@ -140,9 +140,9 @@ pub(super) fn choose(
     dims: Dims,
     pixels: u64,
 ) -> Result<Option<&'static Row>, String> {
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, |n| n.get() as u32)
-    });
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32));
     let row_for = |dims| row_for_time(dims, args.time_limit, pixels, threads);
     let named_here = args.sampler.is_some() || args.filter.is_some();
     match args.pipeline {
@@ -219,7 +219,10 @@ mod tests {
         assert_eq!(row_for_time(dims, Some(0.6), px, 2).filter, "polynomial");
         assert_eq!(row_for_time(dims, None, px, 2), row_for(dims));
         // Four times the pixels want four times the time.
-        assert_eq!(row_for_time(dims, Some(1.5), 4 * px, 2).filter, "polynomial");
+        assert_eq!(
+            row_for_time(dims, Some(1.5), 4 * px, 2).filter,
+            "polynomial"
+        );
         assert!((reserve(Some(&NFOR_ROW), px, 2) - 0.384).abs() < 1e-9);
         assert_eq!(reserve(Some(row_for(dims)), px, 2), 0.0);
         let names: Vec<&str> = crate::registry::all().map(|i| i.name).collect();
