@@ -40,9 +40,9 @@ pub const TABLE: [Row; 4] = [
         filter: "polynomial",
         settings: &[SPP_CAP],
         measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
-                   time\": cornell-box-gi 0.046x / 0.015x / 0.0062x of stratified+gaussian \
-                   against sobol+polynomial's 0.10x / 0.051x / 0.014x; indirect-room-gi 0.11x / \
-                   0.15x / 0.21x against 0.11x / 0.15x / 0.23x",
+                   time\": cornell-box-gi 0.055x / 0.017x / 0.0061x of stratified+gaussian \
+                   against sobol+polynomial's 0.083x / 0.041x / 0.014x; indirect-room-gi 0.11x / \
+                   0.16x / 0.20x against 0.11x / 0.15x / 0.22x",
     },
     Row {
         time: true,
@@ -51,8 +51,8 @@ pub const TABLE: [Row; 4] = [
         filter: "polynomial",
         settings: &[SPP_CAP],
         measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
-                   time\": motion-blur-3d 0.32x / 0.25x / 0.19x of stratified+gaussian against \
-                   cluster+polynomial's 0.42x / 0.23x / 0.21x",
+                   time\": motion-blur-3d 0.58x / 0.36x / 0.23x of stratified+gaussian against \
+                   cluster+polynomial's 0.62x / 0.33x / 0.22x",
     },
     Row {
         time: false,
@@ -61,8 +61,8 @@ pub const TABLE: [Row; 4] = [
         filter: "polynomial",
         settings: &[SPP_CAP],
         measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
-                   time\": depth-of-field-4d 0.64x / 0.56x / 0.59x of stratified+gaussian \
-                   against cluster+polynomial's 0.65x / 0.62x / 0.57x",
+                   time\": depth-of-field-4d 0.75x / 0.64x / 0.60x of stratified+gaussian \
+                   against cluster+polynomial's 0.99x / 0.67x / 0.64x",
     },
     Row {
         time: true,
@@ -71,8 +71,8 @@ pub const TABLE: [Row; 4] = [
         filter: "polynomial",
         settings: &[SPP_CAP],
         measured: "docs/BENCHMARKS.md, \"The fit with and without the cluster sampler at equal \
-                   time\": motion-dof-5d 0.61x / 0.64x / 0.70x of stratified+gaussian against \
-                   cluster+polynomial's 0.74x / 0.69x / 0.79x",
+                   time\": motion-dof-5d 0.82x / 0.75x / 0.74x of stratified+gaussian against \
+                   cluster+polynomial's 1.04x / 0.81x / 0.85x",
     },
 ];
 
