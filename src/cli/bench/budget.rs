@@ -24,21 +24,22 @@ fn equal_time_spp(spp: u32, baseline: Option<f64>, own: Option<f64>) -> u32 {
     }
 }
 
-/// What a method's own equal-spp run at a budget spent: its render (with reconstruction) and
-/// an external method's command.
+/// What a method's own equal-spp run at a budget spent: its sampling, and what comes after
+/// the render's time limit (its reconstruction and an external method's command).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Spent {
-    /// Render plus reconstruction seconds.
+    /// The render's seconds less its reconstruction's: what the time limit bounds.
     pub(super) render: f64,
     /// The seconds after the render's time limit: the reconstruction's plus an external
     /// method's command's.
-    pub(super) command: f64,
+    pub(super) after_limit: f64,
 }
 
 /// A compared run's spp and time limit: at equal spp the budget; at equal time the first
 /// method's seconds at this budget (`baseline`, an error where it failed) less what the
-/// method's reconstruction and command took in its own equal-spp run, as the render's limit, with the spp that
-/// `time_limited_spp` names or that the method's own render seconds (`own`) say fit. An
+/// method's reconstruction and command took in its own equal-spp run, as the render's limit,
+/// with the spp that `time_limited_spp` names or that the method's own render seconds (`own`)
+/// say fit. An
 /// external method (`external`) without its own run cannot know its command's cost: an error.
 pub(super) fn run_budget(
     mode: Mode,
@@ -55,11 +56,11 @@ pub(super) fn run_budget(
     if external && own.is_none() {
         return Err("its equal-spp run failed, so its command's time is unknown".to_owned());
     }
-    let command = own.map_or(0.0, |o| o.command);
-    let limit = baseline - command;
+    let after = own.map_or(0.0, |o| o.after_limit);
+    let limit = baseline - after;
     if limit <= 0.0 {
         return Err(format!(
-            "its reconstruction and command took {command:.3} s, no less than the first method's \
+            "its reconstruction and command took {after:.3} s, no less than the first method's \
              {baseline:.3} s: no time is left to render"
         ));
     }
@@ -92,7 +93,12 @@ mod tests {
             equal_time: true,
             time_limited_spp: None,
         };
-        let spent = |render, command| Some(Spent { render, command });
+        let spent = |render, after_limit| {
+            Some(Spent {
+                render,
+                after_limit,
+            })
+        };
         let run = |mode, base, own, b: &Budgets| run_budget(mode, 8, b, base, own, false);
         assert_eq!(
             run(Mode::EqualSpp, Some(1.0), None, &budgets),

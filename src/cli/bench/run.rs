@@ -241,7 +241,7 @@ impl<'a> Bench<'a> {
                     let after = r.command_seconds.unwrap_or(0.0) + r.reconstruct_seconds;
                     Spent {
                         render: r.seconds - after,
-                        command: after,
+                        after_limit: after,
                     }
                 });
             }

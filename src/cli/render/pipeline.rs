@@ -139,10 +139,8 @@ pub(super) fn choose(
     desc: &SceneDescription,
     dims: Dims,
     pixels: u64,
+    threads: u32,
 ) -> Result<Option<&'static Row>, String> {
-    let threads = args
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32));
     let row_for = |dims| row_for_time(dims, args.time_limit, pixels, threads);
     let named_here = args.sampler.is_some() || args.filter.is_some();
     match args.pipeline {

@@ -38,6 +38,9 @@ pub(super) struct Job {
     pub(super) overrides: Overrides,
     /// The auto pipeline's row, when it chose the sampler and filter.
     pub(super) pipeline: Option<&'static Row>,
+    /// The seconds the render leaves its reconstruction out of `--time-limit` (the auto
+    /// pipeline's nfor; 0 otherwise).
+    pub(super) reserve: f64,
     /// The sampler, filter and integrator.
     pub(super) plugins: Plugins,
     /// Whether the film splats each sample with the filter's kernel (neither the filter's
@@ -53,7 +56,11 @@ impl Job {
         let mut warnings = desc.warnings.clone();
         let scene = build_scene(args, &desc, &mut warnings)?;
         let (w, h) = scene.film.size();
-        let auto = pipeline::choose(args, &desc, scene.dims, u64::from(w) * u64::from(h))?;
+        let pixels = u64::from(w) * u64::from(h);
+        // The pool is started ([`start_threads`]): its size is the render's.
+        let threads = rayon::current_num_threads() as u32;
+        let auto = pipeline::choose(args, &desc, scene.dims, pixels, threads)?;
+        let reserve = pipeline::reserve(auto, pixels, threads);
         let overrides = overrides(args, auto)?;
         let mut plugins =
             choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
@@ -77,6 +84,7 @@ impl Job {
             scene,
             overrides,
             pipeline: auto,
+            reserve,
             plugins,
             splats,
         })

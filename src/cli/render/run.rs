@@ -72,10 +72,7 @@ pub(super) fn render_scene(
     let mut stop = stop_rules(args, &interrupted, &write_partial, &show, &looks);
     if let Some(limit) = stop.time_limit {
         // An auto pipeline's reconstruction comes out of the limit (docs/cli.md).
-        let (w, h) = job.scene.film.size();
-        let threads = rayon::current_num_threads() as u32;
-        let reserve = super::pipeline::reserve(job.pipeline, u64::from(w) * u64::from(h), threads);
-        stop.time_limit = Some(limit.saturating_sub(Duration::from_secs_f64(reserve)));
+        stop.time_limit = Some(limit.saturating_sub(Duration::from_secs_f64(job.reserve)));
     }
     stop.estimated_error = Some(&estimate);
     let mut features = target.aovs.iter().any(AovRequest::is_feature).then(|| {
