@@ -132,34 +132,39 @@ impl Parser {
 
     fn peek(&mut self) -> Result<Option<&Token>> {
         if self.peeked.is_none() {
-            if let Some(t) = self.stack.last_mut() {
-                self.peeked = t.next_token()?;
-            }
+            self.peeked = self.read()?;
         }
         Ok(self.peeked.as_ref())
     }
 
-    /// The next token of the current file; `None` at its end (include files do not continue
-    /// into their parent mid-directive).
+    /// The next token; `None` at the end of the main file.
     fn next(&mut self) -> Result<Option<Token>> {
-        if let Some(t) = self.peeked.take() {
-            return Ok(Some(t));
-        }
-        match self.stack.last_mut() {
-            Some(t) => t.next_token(),
-            None => Ok(None),
+        match self.peeked.take() {
+            Some(t) => Ok(Some(t)),
+            None => self.read(),
         }
     }
 
+    /// The next token of the file on top of the stack; at the end of an included file, the
+    /// next of the file that included it, even inside a directive: pbrt-v3's tokenizer stack
+    /// (its parser.cpp), where the tokens after an `Include` continue the parameter list of
+    /// the included file's last directive. The main file stays on the stack, so every token's
+    /// offset is in [`Parser::file`] when it is read.
+    fn read(&mut self) -> Result<Option<Token>> {
+        while let Some(t) = self.stack.last_mut() {
+            if let Some(tok) = t.next_token()? {
+                return Ok(Some(tok));
+            }
+            if self.stack.len() == 1 {
+                break;
+            }
+            self.stack.pop();
+        }
+        Ok(None)
+    }
+
     fn run(&mut self) -> Result<()> {
-        loop {
-            let Some(tok) = self.next()? else {
-                self.stack.pop();
-                if self.stack.is_empty() {
-                    break;
-                }
-                continue;
-            };
+        while let Some(tok) = self.next()? {
             let loc = self.loc(tok.offset);
             match tok.kind {
                 TokenKind::Word(w) => self.directive(&w, loc)?,

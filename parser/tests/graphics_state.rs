@@ -131,12 +131,24 @@ fn named_materials_are_scoped_and_mix_resolves() {
         d.materials[d.shapes[1].material.unwrap()].name.as_deref(),
         Some("red")
     );
-    // "blue" went out of scope with its attribute block.
-    let e = err(
-        "WorldBegin\nAttributeBegin\nMakeNamedMaterial \"blue\" \"string type\" \"matte\"\n\
-                 AttributeEnd\nNamedMaterial \"blue\"\nWorldEnd",
+    // "blue" went out of scope with its attribute block: as pbrt-v3, naming it is a located
+    // warning and the current material ("red") is kept.
+    let d = parse(
+        "WorldBegin\nMakeNamedMaterial \"red\" \"string type\" \"matte\"\nNamedMaterial \"red\"\n\
+         AttributeBegin\nMakeNamedMaterial \"blue\" \"string type\" \"matte\"\n\
+         AttributeEnd\nNamedMaterial \"blue\"\nShape \"sphere\"\nWorldEnd",
     );
-    assert!(e.contains("no material named \"blue\""), "{e}");
+    let warnings: Vec<String> = d.warnings.iter().map(ToString::to_string).collect();
+    assert!(
+        warnings.iter().any(|w| w
+            .starts_with("test.pbrt:7:1: warning: no material named \"blue\"")
+            && w.contains("the current material is kept")),
+        "{warnings:?}"
+    );
+    assert_eq!(
+        d.materials[d.shapes[0].material.unwrap()].name.as_deref(),
+        Some("red")
+    );
 }
 
 #[test]

@@ -10,16 +10,22 @@ use crate::suggest::did_you_mean;
 use std::sync::Arc;
 
 impl Builder {
-    /// `NamedMaterial "name"`.
+    /// `NamedMaterial "name"`. A name not defined (yet) is a warning that keeps the current
+    /// material, as pbrt-v3's `pbrtNamedMaterial` does: scenes rely on it (pbrt-v3-scenes'
+    /// contemporary-bathroom names a material before the `Include` that defines it).
     pub fn named_material(&mut self, name: &str, loc: &Loc) -> Result<()> {
         self.require_world("NamedMaterial", loc)?;
         match self.graphics.named_materials.get(name) {
-            Some(&i) => {
-                self.graphics.material = Some(i);
-                Ok(())
+            Some(&i) => self.graphics.material = Some(i),
+            None => {
+                let message = format!(
+                    "{}; the current material is kept (as pbrt-v3 does)",
+                    self.unknown_material(name, loc).message()
+                );
+                self.warn(loc, message);
             }
-            None => Err(self.unknown_material(name, loc)),
         }
+        Ok(())
     }
 
     pub(super) fn unknown_material(&self, name: &str, loc: &Loc) -> Error {
