@@ -429,7 +429,7 @@ impl Tracer<'_, '_> {
         let scene = self.scene;
         let full_width = u64::from(scene.film.resolution.0);
         // pbrt-v3 scales the differentials to the spacing of a pixel's samples: 1 / sqrt(spp),
-        // of the scene's own budget (see `Scene::differential_scale`).
+        // of the render's whole budget (see `Scene::set_footprint_spp`).
         let diff_scale = scene.differential_scale;
         batch
             .par_iter()

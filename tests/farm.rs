@@ -451,3 +451,60 @@ fn a_stopped_render_resumes_by_rendering_the_rest_and_merging() {
     assert!(worst < 1e-5, "{worst}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The texture footprint follows the whole render's budget (pbrt-v3's camera-ray differentials
+/// scaled by 1 / sqrt(spp)): `--spp 16` on a scene written for 4 filters its textures as a
+/// 16-spp render, not as the scene's 4 (`--footprint-spp 4` gives that image, which differs);
+/// sample ranges 0..8 and 8..16 rendered with `--footprint-spp 16` merge into the 16-spp
+/// render, and ranges with different footprints are refused by `acr merge`.
+#[test]
+fn the_texture_footprint_follows_the_whole_budget_and_sample_ranges_still_merge() {
+    use acr::cli::mergeable::Sums;
+    let dir = temp_dir("footprint");
+    let scene =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/pbrt-v3/texture-filtering.pbrt");
+    let sc = s(&scene);
+    let path = |name: &str| dir.join(format!("{name}.exr"));
+    let render = |name: &str, extra: &[&str]| {
+        let out = path(name);
+        let mut args = vec!["render", sc, "-o", s(&out), "--sampler", "sobol", "-q"];
+        args.extend(["--pixelbounds", "100,260,60,140", "--mergeable"]);
+        args.extend(extra);
+        ok(&args);
+        Sums::read(&out).unwrap().unwrap()
+    };
+    let full = render("full", &["--spp", "16"]);
+    assert_eq!(full.footprint, Some(16));
+    let said = render("said", &["--spp", "16", "--footprint-spp", "16"]);
+    assert_eq!(full.image(), said.image());
+    let scenes_own = render("own", &["--spp", "16", "--footprint-spp", "4"]);
+    assert_eq!(scenes_own.footprint, Some(4));
+    let moved = worst_relative(&scenes_own.image(), &full.image());
+    assert!(moved > 1e-2, "the footprint changed nothing: {moved}");
+
+    let a = render("a", &["--spp", "8", "--footprint-spp", "16"]);
+    assert_eq!(a.footprint, Some(16));
+    render(
+        "b",
+        &[
+            "--spp",
+            "8",
+            "--sample-offset",
+            "8",
+            "--footprint-spp",
+            "16",
+        ],
+    );
+    ok(&["merge", s(&path("m")), s(&path("a")), s(&path("b"))]);
+    let merged = Sums::read(&path("m")).unwrap().unwrap();
+    assert_eq!((merged.spp, merged.footprint), (16, Some(16)));
+    let worst = worst_relative(&merged.image(), &full.image());
+    assert!(worst < 1e-5, "relative difference {worst}");
+    // Without --footprint-spp, the first range is an 8-spp render's: refused with the remedy.
+    render("a8", &["--spp", "8"]);
+    fails(
+        &["merge", s(&path("bad")), s(&path("a8")), s(&path("b"))],
+        "--footprint-spp",
+    );
+    assert!(!path("bad").exists());
+}

@@ -2,7 +2,8 @@
 //! (`sum.R`, `sum.G`, `sum.B`, times the film's scale), its filter-weight sum (`weight`), its
 //! sample count (`count`) and the variance moments of its samples (`moment1.*`, the sum of
 //! their radiance, and `moment2.*`, of its square, unweighted and unscaled), with pbrt-v4's
-//! header attributes `samplesPerPixel` and `renderTimeSeconds` and acr's `sampleOffset`.
+//! header attributes `samplesPerPixel` and `renderTimeSeconds` and acr's `sampleOffset` (and
+//! `footprintSpp` for a scene whose textures read the ray differentials).
 //! Renders of different sample ranges of one frame add their sums, weights and moments: the
 //! merge is the image of all their samples (Cycles' `merge_images`, weighted). `Variance.*`
 //! (pbrt-v4's name and meaning: the variance of a pixel's samples) is written from the moments.
@@ -37,6 +38,10 @@ pub struct Sums {
     /// A hash of the scene's text (`sceneHash`), when known: renders of other scenes do not
     /// merge.
     pub scene: Option<i32>,
+    /// The whole render's samples per pixel that set its texture footprint (`footprintSpp`,
+    /// `--footprint-spp`), when the scene has textures that read it: ranges rendered with
+    /// other footprints are other images and do not merge.
+    pub footprint: Option<u32>,
     /// Render seconds, summed over merged renders.
     pub seconds: f64,
 }
@@ -111,6 +116,15 @@ impl Sums {
             if a != b {
                 return Err("rendered from another scene (its sceneHash differs)".to_owned());
             }
+        }
+        if self.footprint != other.footprint {
+            let said = |f: Option<u32>| f.map_or("none".to_owned(), |n| n.to_string());
+            return Err(format!(
+                "rendered with another texture footprint (footprintSpp {} against {}): render \
+                 every sample range with the same --footprint-spp, the whole render's spp",
+                said(other.footprint),
+                said(self.footprint)
+            ));
         }
         self.aovs
             .retain(|(name, _)| other.aovs.iter().any(|(n, _)| n == name));
@@ -199,6 +213,12 @@ impl Sums {
                 .attributes
                 .push(("sampleOffset".into(), Attribute::Int(o)));
         }
+        if let Some(f) = self.footprint {
+            let f = f.min(i32::MAX as u32) as i32;
+            layer
+                .attributes
+                .push(("footprintSpp".into(), Attribute::Int(f)));
+        }
         layer.write(path)
     }
 
@@ -257,6 +277,7 @@ impl Sums {
             aovs,
             spp: int("samplesPerPixel").unwrap_or(0),
             offset: int("sampleOffset"),
+            footprint: int("footprintSpp"),
             scene: match layer.attribute("sceneHash") {
                 Some(Attribute::Int(h)) => Some(h),
                 _ => None,

@@ -42,6 +42,9 @@ pub struct Output {
     pub channel_aovs: Vec<String>,
     /// [`scene_hash`] of the scene rendered, written as the `sceneHash` attribute of an EXR.
     pub scene: i32,
+    /// The whole render's samples per pixel that set the texture footprint, written as the
+    /// `footprintSpp` attribute of a mergeable EXR when the scene's textures read it.
+    pub footprint: Option<u32>,
 }
 
 /// A hash of the scene's text (its .pbrt files, FNV-1a folded to 32 bits), so that `acr
@@ -99,6 +102,7 @@ impl Output {
             spp,
             offset: Some(self.offset),
             scene: Some(self.scene),
+            footprint: self.footprint,
             seconds,
         })
     }

@@ -64,14 +64,21 @@ pub struct Scene {
     /// scene far from the world origin renders as precisely as one at it.
     pub render_from_world: DMat4,
     /// How much the camera rays' differentials are scaled (pbrt-v3's 1 / sqrt(samples per
-    /// pixel)), from the scene's own Sampler budget, not `--spp`: a pixel's samples then do
-    /// not depend on how many are taken, so that renders at any spp converge to one image and
-    /// sample ranges merge exactly.
+    /// pixel)): of the scene's own Sampler budget when built, of the render's whole budget
+    /// once [`Scene::set_footprint_spp`] says it (`acr render` does).
     pub differential_scale: f32,
     /// Whether anything looks at a hit's footprint (image maps, checkerboards, noise textures,
     /// bump maps): when nothing does, camera rays go without differentials (two camera rays
     /// fewer per sample; the image is the same).
     pub uses_differentials: bool,
+}
+
+impl Scene {
+    /// Scales the camera rays' differentials for a render of `spp` samples per pixel in all
+    /// (pbrt-v3's `ScaleDifferentials(1 / sqrt(spp))`, docs/pbrt-v3-compatibility.md).
+    pub fn set_footprint_spp(&mut self, spp: u32) {
+        self.differential_scale = 1.0 / (spp.max(1) as f32).sqrt();
+    }
 }
 
 /// Whether the scene has a texture class or a bump map that reads the ray differentials.

@@ -118,6 +118,13 @@ pub struct RenderArgs {
     /// them all. Samplers whose points depend on the index alone (random, sobol).
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub sample_offset: u32,
+    /// The samples per pixel of the whole render this one is part of, which sets the texture
+    /// footprint (camera-ray differentials scaled by 1 / sqrt(N), as pbrt-v3): give every
+    /// sample range of one frame the same N, so that they merge into its render. Default:
+    /// --sample-offset + the budget (--spp or the scene's; an adaptive sampler's or a time
+    /// limit's most), which is the whole render for its first part or its only one.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub footprint_spp: Option<u32>,
     /// Write an EXR that `acr merge` can combine with renders of other sample ranges: beside
     /// R, G, B, each pixel's weighted radiance sums, filter-weight sum and sample count, and
     /// the header attributes samplesPerPixel and renderTimeSeconds (pbrt-v4's names).

@@ -179,9 +179,13 @@ fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> Strin
     let spp = rendered.spp;
     let reached = reached_spp(rendered.film.pixel_stats());
     let resume = if target.out.can_merge {
+        // The rest's default footprint is this render's unless the command line chose one.
+        let footprint = args
+            .footprint_spp
+            .map_or(String::new(), |n| format!(" --footprint-spp {n}"));
         format!(
             "a mergeable EXR of sample indices {}..{}: render the rest with --sample-offset {} \
-             --spp {} --mergeable and `acr merge` the two",
+             --spp {}{footprint} --mergeable and `acr merge` the two",
             args.sample_offset,
             args.sample_offset + reached,
             args.sample_offset + reached,

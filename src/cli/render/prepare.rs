@@ -54,7 +54,7 @@ impl Job {
     pub(super) fn prepare(args: &RenderArgs, desc: SceneDescription) -> Result<Job, String> {
         let spp = if args.quick { Some(1) } else { args.spp };
         let mut warnings = desc.warnings.clone();
-        let scene = build_scene(args, &desc, &mut warnings)?;
+        let mut scene = build_scene(args, &desc, &mut warnings)?;
         let (w, h) = scene.film.size();
         let pixels = u64::from(w) * u64::from(h);
         // The pool is started ([`start_threads`]): its size is the render's.
@@ -66,6 +66,7 @@ impl Job {
             choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
                 .map_err(|e| e.to_string())?;
         start_at_sample_offset(args.sample_offset, &mut plugins)?;
+        scene.set_footprint_spp(footprint_spp(args, plugins.sampler.spp()));
         let splats = plugins.filter.cell_layout().is_none() && !plugins.sampler.reconstructs();
         if args.mergeable && (!splats || plugins.sampler.streams() > 1) {
             return Err(format!(
@@ -151,6 +152,14 @@ fn start_at_sample_offset(offset: u32, plugins: &mut Plugins) -> Result<(), Stri
         ));
     }
     Ok(())
+}
+
+/// The samples per pixel of the whole render, which set the texture footprint:
+/// `--footprint-spp`, else the last sample index this render reaches (`--sample-offset` +
+/// `spp`, the sampler's budget: the most an adaptive sampler or a time limit may reach).
+pub(super) fn footprint_spp(args: &RenderArgs, spp: u32) -> u32 {
+    args.footprint_spp
+        .unwrap_or_else(|| args.sample_offset.saturating_add(spp))
 }
 
 /// Prints the scene's warnings and those of its unused parameters, each once.

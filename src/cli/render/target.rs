@@ -66,6 +66,10 @@ fn output_of(args: &RenderArgs, job: &Job, path: PathBuf, is_exr: bool) -> Outpu
         channel_aovs: Vec::new(),
         // Only an EXR carries the hash: a PNG or PFM render does not read the scene again.
         scene: if is_exr { scene_hash(&job.desc) } else { 0 },
+        footprint: job
+            .scene
+            .uses_differentials
+            .then(|| super::prepare::footprint_spp(args, job.plugins.sampler.spp())),
     }
 }
 
