@@ -150,6 +150,21 @@ fn an_include_that_ends_mid_directive_gives_located_errors() {
             " WorldEnd ]\n",
             "main.pbrt:2:20: parameter \"radius\": unexpected 'WorldEnd' among its values",
         ),
+        (
+            "AttributeBegin",
+            " \"float radius\" 1\n",
+            "main.pbrt:2:20: expected a directive, found string \"float radius\"",
+        ),
+        (
+            "",
+            " 2 3\n",
+            "main.pbrt:2:20: expected a directive, found number 2",
+        ),
+        (
+            "Shape \"sphere\" \"float radius\" [ 1 \"",
+            " ]\n",
+            "inc.pbrt:1:35: unterminated string",
+        ),
     ];
     for (i, (inc, after, want)) in inc_ending.into_iter().enumerate() {
         let main = format!("WorldBegin\nInclude \"inc.pbrt\"{after}");
