@@ -92,9 +92,17 @@ impl FilmSettings {
 
     /// Crops to a window given in fractions of the image, [x0, x1, y0, y1] (pbrt-v3's
     /// `cropwindow`: the ceiling of each edge in raster space; values clamped to [0, 1]).
+    /// The products are in f32 as pbrt-v3's (its `Float`): 0.6 of 800 is then 481, not 480,
+    /// so that a crop has pbrt-v3's pixels.
     pub fn set_crop_window(&mut self, window: [f64; 4]) -> std::result::Result<(), String> {
-        let [x0, x1, y0, y1] = window.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) });
-        let (w, h) = (self.resolution.0 as f64, self.resolution.1 as f64);
+        let [x0, x1, y0, y1] = window.map(|v| {
+            if v.is_nan() {
+                0.0
+            } else {
+                v.clamp(0.0, 1.0) as f32
+            }
+        });
+        let (w, h) = (self.resolution.0 as f32, self.resolution.1 as f32);
         self.set_pixel_bounds([
             (w * x0.min(x1)).ceil() as u32,
             (w * x0.max(x1)).ceil() as u32,

@@ -161,3 +161,15 @@ fn wide_filter_reaches_neighbours_and_crop_limits_output() {
         assert!((v - Spectrum::new(1.0, 2.0, 3.0)).length() < 1e-6);
     }
 }
+
+/// The crop window's edges are pbrt-v3's: the ceiling of resolution x fraction computed in
+/// f32 (its `Float`), so 0.6 of 800 is pixel 481 (0.6f x 800 = 480.00002), as pbrt-v3's crop
+/// of that window is 161 pixels wide; exact products stay exact.
+#[test]
+fn crop_window_edges_round_as_pbrt_v3_computes_them() {
+    let mut s = FilmSettings::with_resolution(800, 400);
+    s.set_crop_window([0.4, 0.6, 0.4, 0.6]).unwrap();
+    assert_eq!(s.crop, [320, 481, 160, 241]);
+    s.set_crop_window([0.25, 0.5, 0.0, 1.0]).unwrap();
+    assert_eq!(s.crop, [200, 400, 0, 400]);
+}
