@@ -255,7 +255,7 @@ fn quick_renders_a_quarter_resolution_at_one_sample() {
 
 /// Sample ranges: for every sampler whose points depend on the index alone and every
 /// splatting filter, the renders of indices 0..8 and 8..16 (`--sample-offset 8`, mergeable
-/// EXRs) merge into the 16-spp render, to within the f32 storage of the weighted sums (measured
+/// EXRs, `--footprint-spp 16`) merge into the 16-spp render, to within the f32 storage of the weighted sums (measured
 /// relative differences 1.2e-7 to 3.6e-7; asserted below 1e-5), with every pixel's count 16 and
 /// samplesPerPixel 16.
 #[test]
@@ -266,6 +266,8 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
     let sc = s(&scene);
     for sampler in ["random", "sobol"] {
         for filter in ["box", "gaussian", "mitchell", "triangle", "sinc"] {
+            // The scene's checkerboard is filtered over the whole render's footprint: every
+            // range names it.
             let common = [
                 "--sampler",
                 sampler,
@@ -273,6 +275,8 @@ fn sample_ranges_merge_into_the_render_of_all_their_samples() {
                 filter,
                 "-q",
                 "--mergeable",
+                "--footprint-spp",
+                "16",
             ];
             let path = |name: &str| dir.join(format!("{name}.exr"));
             let (full, a, b, m) = (path("full"), path("a"), path("b"), path("m"));
