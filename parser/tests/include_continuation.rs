@@ -196,3 +196,74 @@ fn nested_includes_continue_outward_one_file_at_a_time() {
     assert_eq!(p.float("zmin").unwrap(), Some(-0.5));
     assert_eq!(p.float("zmax").unwrap(), Some(0.5));
 }
+
+/// The starts of the tokens of `text` after its first, where a file may be cut.
+fn token_starts(text: &str) -> Vec<usize> {
+    let mut t = acr_parser::lexer::Tokenizer::new(acr_parser::SourceFile::new("t.pbrt", text));
+    let mut out = Vec::new();
+    while let Ok(Some(tok)) = t.next_token() {
+        out.push(tok.offset);
+    }
+    out.split_off(1.min(out.len()))
+}
+
+/// Asserts that `r` parsed, or failed with an error at a line and column in one of the files
+/// `dir` holds; gives whether it failed.
+fn ok_or_located(r: &Result<SceneDescription, Error>, dir: &Path, texts: &[(&str, &str)]) -> bool {
+    let Err(e) = r else { return false };
+    let Error::At { loc, .. } = e else {
+        panic!("an error with no place: {e}")
+    };
+    let (name, text) = texts
+        .iter()
+        .find(|(n, _)| loc.file.path == dir.join(n))
+        .unwrap_or_else(|| panic!("{e}: not in {texts:?}"));
+    let (line, col) = loc.line_col();
+    assert!(
+        (1..=text.split('\n').count()).contains(&line) && col >= 1,
+        "{name}: {line}:{col} is not in the text: {e}"
+    );
+    true
+}
+
+/// A scene cut anywhere between its tokens into an included file (its start) and the file that
+/// includes it first thing (its rest) is the same scene, as one token stream; and every prefix
+/// of that rest gives the scene or a located error, never a panic.
+#[test]
+fn a_scene_cut_anywhere_into_an_include_and_its_rest_is_the_same_scene() {
+    let scene = "LookAt 0 0 5 0 0 0 0 1 0 Camera \"perspective\" \"float fov\" [45]\n\
+                 WorldBegin AttributeBegin Material \"matte\" \"rgb Kd\" [.5 .5 .5]\n\
+                 Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n\
+                 AttributeEnd Shape \"sphere\" \"float radius\" 2 WorldEnd\n";
+    let whole = acr_parser::parse_str(scene, Path::new("whole.pbrt")).unwrap();
+    let dir = folder("cut", &[]);
+    let mut errors = 0;
+    for cut in token_starts(scene) {
+        let (head, rest) = scene.split_at(cut);
+        let main = format!("Include \"inc.pbrt\" {rest}");
+        std::fs::write(dir.join("inc.pbrt"), head).unwrap();
+        std::fs::write(dir.join("main.pbrt"), &main).unwrap();
+        let d = parse_file(&dir.join("main.pbrt")).unwrap_or_else(|e| panic!("cut at {cut}: {e}"));
+        assert_eq!(d.shapes.len(), whole.shapes.len(), "cut at {cut}");
+        let params = |d: &SceneDescription| {
+            d.shapes
+                .iter()
+                .map(|s| {
+                    s.plugin
+                        .params
+                        .iter()
+                        .map(|p| p.name.clone())
+                        .collect::<Vec<_>>()
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(params(&d), params(&whole), "cut at {cut}");
+        for end in token_starts(&main).into_iter().step_by(3) {
+            std::fs::write(dir.join("main.pbrt"), &main[..end]).unwrap();
+            let r = parse_file(&dir.join("main.pbrt"));
+            let texts = [("main.pbrt", &main[..end]), ("inc.pbrt", head)];
+            errors += usize::from(ok_or_located(&r, &dir, &texts));
+        }
+    }
+    assert!(errors > 100, "only {errors} errors");
+}
