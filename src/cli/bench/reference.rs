@@ -54,6 +54,12 @@ fn reference_key(
         env!("CARGO_PKG_VERSION")
     );
     fnv1a(&mut h, m.as_bytes());
+    // A textured scene's reference filters its textures for the reference's own budget
+    // (docs/pbrt-v3-compatibility.md, "Ray differentials"): references cached before that
+    // rule used the scene's own spp and must not be read back. Untextured keys are unchanged.
+    if !desc.textures.is_empty() {
+        fnv1a(&mut h, format!("|footprint spp {spp}").as_bytes());
+    }
     // Uncropped keys stay those of before, so that cached references remain valid.
     if let Some(b) = pixelbounds {
         fnv1a(&mut h, format!("|pixelbounds {b:?}").as_bytes());
@@ -118,6 +124,50 @@ pub(super) fn reference_image(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Keys of references cached before the footprint rule: an untextured scene's key is the
+    /// same as then, a textured one's is not.
+    #[test]
+    fn only_textured_keys_carry_the_footprint() {
+        let dir = std::env::temp_dir().join(format!("acr-refkey-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let plain = "WorldBegin\nShape \"sphere\"\nWorldEnd\n";
+        let textured = "WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\n\
+                        Shape \"sphere\"\nWorldEnd\n";
+        let method = Method {
+            sampler: Some("sobol".into()),
+            filter: Some("box".into()),
+            ..Method::default()
+        };
+        let key = |name: &str, text: &str| {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            let desc = acr_parser::parse_file(&path).unwrap();
+            // The key as computed before the rule: the files, then the method string.
+            let mut old = 0xcbf2_9ce4_8422_2325u64;
+            for f in &desc.files {
+                fnv1a(&mut old, f.text.as_bytes());
+                fnv1a(&mut old, &[0xff]);
+            }
+            let m = format!(
+                "{:?}|{:?}|{:?}|{:?}|{}|{}|{}",
+                method.sampler,
+                method.filter,
+                method.integrator,
+                method.set,
+                1024,
+                1,
+                env!("CARGO_PKG_VERSION")
+            );
+            fnv1a(&mut old, m.as_bytes());
+            (reference_key(&path, &method, 1024, 1, None).unwrap(), old)
+        };
+        let (now, before) = key("plain.pbrt", plain);
+        assert_eq!(now, before);
+        let (now, before) = key("textured.pbrt", textured);
+        assert_ne!(now, before);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn fnv_is_stable() {
