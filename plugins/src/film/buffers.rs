@@ -6,6 +6,7 @@
 // Small fixed-size channel and matrix loops read clearest with indices.
 #![allow(clippy::needless_range_loop)]
 
+use super::stats::PixelStats;
 use crate::first_hit::{Features, FEATURES};
 use crate::space::SamplePoint;
 
@@ -90,6 +91,17 @@ impl PixelBuffers {
     /// Half `h`'s pixels (0 or 1), row-major.
     pub fn half(&self, h: usize) -> &[HalfPixel] {
         &self.halves[h & 1]
+    }
+
+    /// Each pixel's statistics over both halves, row-major: what the film's own pixel
+    /// statistics would hold, combined from the halves ([`PixelStats::combined`]).
+    pub fn pixel_stats(&self) -> Vec<PixelStats> {
+        let part = |p: &HalfPixel| (p.count, p.color, p.color_m2);
+        self.halves[0]
+            .iter()
+            .zip(&self.halves[1])
+            .map(|(a, b)| PixelStats::combined(part(a), part(b)))
+            .collect()
     }
 
     /// Adds the samples of a batch: each point's radiance (NaN: dropped, skipped) and
