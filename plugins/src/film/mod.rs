@@ -19,6 +19,7 @@ use splat::{Prepared, Splat, TABLE_SIZE};
 pub use stats::{relative_error_of, PixelStats};
 
 mod buffers;
+mod half_float;
 mod settings;
 mod splat;
 mod stats;

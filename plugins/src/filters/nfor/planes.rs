@@ -186,8 +186,9 @@ fn half_variance<const N: usize>(
 pub(crate) fn depth_scale(b: &PixelBuffers) -> f32 {
     let (mut dsum, mut dcount) = (0.0f64, 0u64);
     for p in b.half(0).iter().chain(b.half(1)) {
-        if p.count > 0 && p.features[DEPTH] > 0.0 {
-            dsum += f64::from(p.features[DEPTH]);
+        let depth = p.features()[DEPTH];
+        if p.count > 0 && depth > 0.0 {
+            dsum += f64::from(depth);
             dcount += 1;
         }
     }
@@ -260,7 +261,8 @@ impl Inputs {
             (pa.count, pa.color_variance_of_mean()),
             cdiff,
         );
-        let fdiff: [f32; FEATURES] = std::array::from_fn(|k| pa.features[k] - pb.features[k]);
+        let (ma, mb) = (pa.features(), pb.features());
+        let fdiff: [f32; FEATURES] = std::array::from_fn(|k| ma[k] - mb[k]);
         let fa = half_variance(
             (pa.count, pa.features_variance_of_mean()),
             (pb.count, pb.features_variance_of_mean()),
@@ -289,11 +291,11 @@ impl Inputs {
         let scale = |k: usize| if k == DEPTH { depth_scale } else { 1.0 };
         for k in 0..FEATURES {
             let s = scale(k);
-            feats.features[0].px_mut(i)[k] = pa.features[k] * s;
-            feats.features[1].px_mut(i)[k] = pb.features[k] * s;
+            feats.features[0].px_mut(i)[k] = ma[k] * s;
+            feats.features[1].px_mut(i)[k] = mb[k] * s;
             feats.variance[0].px_mut(i)[k] = fa[k] * s * s;
             feats.variance[1].px_mut(i)[k] = fb[k] * s * s;
         }
-        self.hit[i] = pa.features.iter().chain(&pb.features).any(|&f| f != 0.0);
+        self.hit[i] = ma.iter().chain(&mb).any(|&f| f != 0.0);
     }
 }
