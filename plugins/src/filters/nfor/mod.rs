@@ -143,7 +143,8 @@ impl NforFilter {
         let halo = self.reach(second).next_multiple_of(TILE);
         let mut y = 0;
         while y < h {
-            let end = (y + band).min(h);
+            // A remainder within the halo joins its band: those rows are read anyway.
+            let end = if y + band + halo >= h { h } else { y + band };
             let rows = y.saturating_sub(halo)..(end + halo).min(h);
             let (image, mse) = self.denoise(b, rows.clone(), depth, ks, second);
             take(&image, &mse, y - rows.start..end - rows.start);
