@@ -525,7 +525,7 @@ impl<'s, 'a> Watch<'s, 'a> {
         } else if let Some(threshold) = stop.noise_threshold {
             if counts.samples >= self.next_check {
                 self.next_check = counts.samples + self.pixels;
-                if relative_error(film.pixel_stats()) < threshold {
+                if relative_error(&film.pixel_stats()) < threshold {
                     counts.halted_by = Some(Halt::Noise);
                     sampler.halt();
                 }

@@ -253,6 +253,63 @@ fn quick_renders_a_quarter_resolution_at_one_sample() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A filter that reads half buffers (nfor) keeps no splats nor pixel statistics: its mergeable
+/// file, its spp and variance AOVs come from the halves and equal the box filter's (one pixel
+/// wide) to f32 rounding, and its sample ranges merge into the render of all their samples.
+#[test]
+fn nfor_writes_the_box_filters_sums_and_aovs_from_its_halves() {
+    use acr::cli::mergeable::Sums;
+    use acr::image_io::read_image;
+    let dir = temp_dir("nfor-sums");
+    let scene = scene();
+    let sc = s(&scene);
+    let path = |name: &str| dir.join(format!("{name}.exr"));
+    let render = |filter: &str, out: &PathBuf, more: &[&str]| {
+        let mut args = vec!["render", sc, "-o", s(out), "--sampler", "sobol", "--filter"];
+        args.extend([filter, "-q", "--pixelbounds", "100,180,40,100"]);
+        args.extend(more);
+        ok(&args);
+    };
+    let mut read = Vec::new();
+    for filter in ["box", "nfor"] {
+        let (img, spp, var) = (path(filter), path("spp"), path("var"));
+        let aov = format!("spp={},variance={}", s(&spp), s(&var));
+        render(filter, &img, &["--spp", "8", "--aov", &aov]);
+        let spp = read_image(&spp, false).unwrap().pixels;
+        let var = read_image(&var, false).unwrap().pixels;
+        render(filter, &img, &["--spp", "8", "--mergeable"]);
+        read.push((spp, var, Sums::read(&img).unwrap().unwrap()));
+    }
+    let ((bspp, bvar, bsums), (nspp, nvar, nsums)) = (&read[0], &read[1]);
+    assert_eq!(bspp, nspp);
+    assert!(nspp.iter().all(|c| c.x == 8.0));
+    let rows = |v: &[acr::geometry::Spectrum]| v.iter().map(|c| c.to_array()).collect::<Vec<_>>();
+    let worst_var = worst_relative(&rows(nvar), &rows(bvar));
+    assert!(worst_var < 1e-4, "variance {worst_var}");
+    assert!(nvar.iter().any(|c| c.max_element() > 0.0));
+    assert_eq!(bsums.counts, nsums.counts);
+    assert_eq!(nsums.spp, 8);
+    let worst = worst_relative(&nsums.image(), &bsums.image());
+    assert!(worst < 1e-5, "image {worst}");
+    let (mv, bv) = (nsums.variance().unwrap(), bsums.variance().unwrap());
+    let worst = worst_relative(&mv, &bv);
+    assert!(worst < 1e-4, "moments {worst}");
+    // Ranges 0..4 and 4..8 merge into the 8-spp file.
+    let (a, b, m) = (path("a"), path("b"), path("m"));
+    render("nfor", &a, &["--spp", "4", "--mergeable"]);
+    render(
+        "nfor",
+        &b,
+        &["--spp", "4", "--sample-offset", "4", "--mergeable"],
+    );
+    ok(&["merge", s(&m), s(&a), s(&b)]);
+    let merged = Sums::read(&m).unwrap().unwrap();
+    assert_eq!(merged.counts, nsums.counts);
+    let worst = worst_relative(&merged.image(), &nsums.image());
+    assert!(worst < 1e-5, "merged {worst}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Sample ranges: for every sampler whose points depend on the index alone and every
 /// splatting filter, the renders of indices 0..8 and 8..16 (`--sample-offset 8`, mergeable
 /// EXRs, `--footprint-spp 16`) merge into the 16-spp render, to within the f32 storage of the weighted sums (measured

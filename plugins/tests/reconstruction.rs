@@ -168,7 +168,7 @@ fn constant_radiance_reconstructs_exactly_with_every_filter() {
                     i / 16 + 3
                 );
             }
-            for st in film.pixel_stats() {
+            for st in film.pixel_stats().iter() {
                 assert_eq!(st.count, 4);
                 assert!(((st.mean() - c) / c).abs().max_element() < 1e-6);
                 assert!(st.variance_of_mean().max_element() < 1e-10);

@@ -111,12 +111,12 @@ impl Output {
     /// merged (samplesPerPixel: the fewest samples any pixel has), else the splatted image.
     pub fn write_partial(&self, film: &Film, seconds: f64) -> Result<(), String> {
         if self.can_merge {
-            let spp = reached_spp(film.pixel_stats());
+            let spp = reached_spp(&film.pixel_stats());
             let sums = self.sums(film, spp, seconds)?;
             return self.atomically(|temp| sums.write(temp));
         }
         let image: Vec<Spectrum> = film.pixels().into_iter().map(|c| c * self.scale).collect();
-        let spp = reached_spp(film.pixel_stats());
+        let spp = reached_spp(&film.pixel_stats());
         self.write_image(&image, Vec::new(), spp)
     }
 
@@ -134,14 +134,14 @@ impl Output {
         for name in &self.channel_aovs {
             aovs.extend(channel_values(
                 name,
-                film.pixel_stats(),
+                &film.pixel_stats(),
                 self.scale,
                 end.features,
             )?);
         }
         if self.writes_sums(end.signalled) {
             let spp = if end.halted {
-                reached_spp(film.pixel_stats())
+                reached_spp(&film.pixel_stats())
             } else {
                 end.spp
             };
@@ -157,7 +157,7 @@ impl Output {
             return self.atomically(|temp| sums.write(temp));
         }
         let spp = if end.halted {
-            reached_spp(film.pixel_stats())
+            reached_spp(&film.pixel_stats())
         } else {
             end.spp
         };

@@ -1,15 +1,22 @@
 //! Per-pixel half buffers for a reconstruction that estimates its own error from two
 //! independent halves of the samples (NFOR, docs/reconstruction.md): a sample's half is its
 //! index's parity. Each half keeps, per pixel, the count, the running mean and sum of squared
-//! deviations of the colour and of the first-hit features (Welford's form, stable in f32).
+//! deviations of the colour and of the first-hit features (Welford's form, stable in f32): the
+//! colour and depth in f32, the albedo and normal in half precision (60 bytes a half, not 88).
 
 // Small fixed-size channel and matrix loops read clearest with indices.
 #![allow(clippy::needless_range_loop)]
 
-use crate::first_hit::{Features, FEATURES};
+use super::half_float::{from_half, to_half};
+use super::stats::PixelStats;
+use crate::first_hit::{Features, DEPTH, FEATURES};
 use crate::space::SamplePoint;
 
-/// One half's statistics for one pixel: 88 bytes.
+/// The features kept in half precision: the albedo and the normal, each channel within
+/// [-1, 1] or near it (depth, on the scene's scale, stays f32).
+const PACKED: usize = DEPTH;
+
+/// One half's statistics for one pixel: 60 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HalfPixel {
     /// Samples in this half.
@@ -18,10 +25,13 @@ pub struct HalfPixel {
     pub color: [f32; 3],
     /// Sum of squared deviations of the colour from its mean.
     pub color_m2: [f32; 3],
-    /// Mean first-hit features.
-    pub features: Features,
-    /// Sum of squared deviations of the features from their mean.
-    pub features_m2: Features,
+    /// The depth's mean and sum of squared deviations.
+    depth: [f32; 2],
+    /// The other features' means, binary16 ([`to_half`]): 11 significant bits are far below
+    /// their sampling noise, and they take half the memory.
+    packed: [u16; PACKED],
+    /// Their sums of squared deviations, binary16.
+    packed_m2: [u16; PACKED],
 }
 
 impl HalfPixel {
@@ -35,11 +45,35 @@ impl HalfPixel {
             self.color[c] += delta * inv;
             self.color_m2[c] += delta * (l[c] - self.color[c]);
         }
+        let (mut mean, mut m2) = (self.features(), self.features_m2());
         for k in 0..FEATURES {
-            let delta = f[k] - self.features[k];
-            self.features[k] += delta * inv;
-            self.features_m2[k] += delta * (f[k] - self.features[k]);
+            let delta = f[k] - mean[k];
+            mean[k] += delta * inv;
+            m2[k] += delta * (f[k] - mean[k]);
         }
+        self.depth = [mean[DEPTH], m2[DEPTH]];
+        for k in 0..PACKED {
+            self.packed[k] = to_half(mean[k]);
+            self.packed_m2[k] = to_half(m2[k]);
+        }
+    }
+
+    /// The mean first-hit features.
+    #[inline]
+    pub fn features(&self) -> Features {
+        std::array::from_fn(|k| match k {
+            DEPTH => self.depth[0],
+            k => from_half(self.packed[k]),
+        })
+    }
+
+    /// The features' sums of squared deviations from their mean.
+    #[inline]
+    pub fn features_m2(&self) -> Features {
+        std::array::from_fn(|k| match k {
+            DEPTH => self.depth[1],
+            k => from_half(self.packed_m2[k]),
+        })
     }
 
     /// The variance of this half's mean colour, per channel: the sample variance over the
@@ -55,7 +89,7 @@ impl HalfPixel {
     pub fn features_variance_of_mean(&self) -> Option<Features> {
         (self.count >= 2).then(|| {
             let n = self.count as f32;
-            self.features_m2.map(|m2| m2.max(0.0) / ((n - 1.0) * n))
+            self.features_m2().map(|m2| m2.max(0.0) / ((n - 1.0) * n))
         })
     }
 }
@@ -90,6 +124,17 @@ impl PixelBuffers {
     /// Half `h`'s pixels (0 or 1), row-major.
     pub fn half(&self, h: usize) -> &[HalfPixel] {
         &self.halves[h & 1]
+    }
+
+    /// Each pixel's statistics over both halves, row-major: what the film's own pixel
+    /// statistics would hold, combined from the halves ([`PixelStats::combined`]).
+    pub fn pixel_stats(&self) -> Vec<PixelStats> {
+        let part = |p: &HalfPixel| (p.count, p.color, p.color_m2);
+        self.halves[0]
+            .iter()
+            .zip(&self.halves[1])
+            .map(|(a, b)| PixelStats::combined(part(a), part(b)))
+            .collect()
     }
 
     /// Adds the samples of a batch: each point's radiance (NaN: dropped, skipped) and
@@ -142,6 +187,7 @@ mod tests {
         assert_eq!(b.half(0)[0].count, 0);
         let v = b.half(0)[1].color_variance_of_mean().expect("two samples");
         assert!((v[0] - 1.0).abs() < 1e-6, "{v:?}");
-        assert_eq!(b.half(0)[1].features, [0.5; FEATURES]);
+        assert_eq!(b.half(0)[1].features(), [0.5; FEATURES]);
+        assert_eq!(std::mem::size_of::<HalfPixel>(), 60);
     }
 }

@@ -1,7 +1,8 @@
 //! The film: pbrt-v3's image film. Each sample is splatted into every pixel within the filter's
 //! radius, weighted; a pixel's value is its weighted mean. Beside the splats it keeps each
 //! pixel's own samples' count, sum and sum of squares, for the spp and variance AOVs and for
-//! filters that reconstruct from per-pixel statistics.
+//! filters that reconstruct from per-pixel statistics. A film that keeps half buffers for its
+//! filter keeps neither: the pixel statistics, the image and the sums are read from the halves.
 
 use crate::cells::grid::MAX_DIMS;
 use crate::cells::{CellGrid, CellSums, CellView};
@@ -9,6 +10,7 @@ use crate::first_hit::Features;
 use crate::kernel::FilterKernel;
 use crate::space::SamplePoint;
 use glam::Vec2;
+use std::borrow::Cow;
 
 pub use crate::color::{luminance, Spectrum};
 pub use buffers::{HalfPixel, PixelBuffers};
@@ -17,6 +19,7 @@ use splat::{Prepared, Splat, TABLE_SIZE};
 pub use stats::{relative_error_of, PixelStats};
 
 mod buffers;
+mod half_float;
 mod settings;
 mod splat;
 mod stats;
@@ -78,8 +81,14 @@ impl Film {
 
     /// Makes the film keep each pixel's two halves of samples (by index parity) with their
     /// colour and first-hit features ([`PixelBuffers`]); the render loop then computes the
-    /// features of every sample. Called before any sample is added.
+    /// features of every sample. The halves hold all the film would: it keeps no splats nor
+    /// pixel statistics of its own (60 bytes a pixel), and [`Film::pixel_stats`],
+    /// [`Film::pixels`] and [`Film::weighted_sums`] are computed from the halves (the kernel
+    /// is then a box of one pixel). Called before any sample is added.
     pub fn keep_pixel_buffers(&mut self) {
+        // Freed before the buffers are made, so that the peak holds one or the other.
+        self.sums = Vec::new();
+        self.stats = Vec::new();
         let [cx0, _, cy0, _] = self.settings.crop;
         let (w, h) = self.settings.size();
         self.buffers = Some(Box::new(PixelBuffers::new(w, h, [cx0, cy0])));
@@ -141,6 +150,10 @@ impl Film {
     /// stream's film, and their statistics to this one's; the same as
     /// [`Film::add_samples`] when the film is not split.
     pub fn add_stream_samples(&mut self, stream: usize, samples: &[(Vec2, Spectrum)]) {
+        if self.buffers.is_some() {
+            // The half buffers took them in [`Film::add_points`].
+            return;
+        }
         match self.halves.as_mut() {
             Some(h) => {
                 h[stream & 1].add_samples(samples);
@@ -227,6 +240,10 @@ impl Film {
     /// film's limits ([`FilmSettings::clamp`]) once, before the sampler, the cells and the film
     /// see a sample.
     pub fn add_sample(&mut self, p: Vec2, l: Spectrum) {
+        if self.buffers.is_some() {
+            // With half buffers, samples come in with their index through add_points.
+            return;
+        }
         let [_, _, cy0, cy1] = self.settings.crop;
         let ry = self.splat.radius.1;
         let dy = p.y - 0.5;
@@ -254,6 +271,10 @@ impl Film {
         let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
             return;
         };
+        if self.buffers.is_some() {
+            // The half buffers took them in [`Film::add_points`].
+            return;
+        }
         self.add_stats(samples);
         let cy0 = self.settings.crop[2] as i64;
         let ry = self.splat.radius.1;
@@ -317,30 +338,55 @@ impl Film {
         inside.then(|| (y as u32 - cy0) as usize * (cx1 - cx0) as usize + (x as u32 - cx0) as usize)
     }
 
-    /// Each pixel's own samples, row-major over the cropped image.
-    pub fn pixel_stats(&self) -> &[PixelStats] {
-        &self.stats
+    /// Each pixel's own samples, row-major over the cropped image: computed from the half
+    /// buffers when the film keeps them.
+    pub fn pixel_stats(&self) -> Cow<'_, [PixelStats]> {
+        match &self.buffers {
+            Some(b) => Cow::Owned(b.pixel_stats()),
+            None => Cow::Borrowed(&self.stats),
+        }
     }
 
     /// Each pixel's filter-weighted sums of radiance and its sum of filter weights, [r, g, b,
     /// w], row-major: what renders of different sample ranges add to merge (`None` when the
-    /// streams are split: the image is then a mean of two films).
-    pub fn weighted_sums(&self) -> Option<&[[f64; 4]]> {
-        self.halves.is_none().then_some(self.sums.as_slice())
+    /// streams are split: the image is then a mean of two films). With half buffers, the
+    /// pixel's own samples' sums and count (a box of one pixel).
+    pub fn weighted_sums(&self) -> Option<Cow<'_, [[f64; 4]]>> {
+        if self.halves.is_some() {
+            return None;
+        }
+        Some(match &self.buffers {
+            Some(b) => Cow::Owned(
+                b.pixel_stats()
+                    .iter()
+                    .map(|s| {
+                        let m = s.sum();
+                        [m[0], m[1], m[2], f64::from(s.count)]
+                    })
+                    .collect(),
+            ),
+            None => Cow::Borrowed(&self.sums),
+        })
     }
 
-    /// Frees the filter-weighted sums (and the streams' films), once the image is made and
-    /// nothing will merge them: they are the largest part of the film (32 bytes a pixel), and
-    /// the output is written after. [`Film::pixels`] and [`Film::weighted_sums`] are then empty.
+    /// Frees the filter-weighted sums (and the streams' films and the half buffers, keeping
+    /// their pixel statistics), once the image is made and nothing will merge them: they are
+    /// the largest part of the film (32 bytes a pixel; the halves 176), and the output is
+    /// written after. [`Film::pixels`] and [`Film::weighted_sums`] are then empty.
     pub fn release_sums(&mut self) {
+        if let Some(b) = self.buffers.take() {
+            self.stats = b.pixel_stats();
+        }
         self.sums = Vec::new();
         self.halves = None;
-        self.buffers = None;
     }
 
     /// The splatted image: each pixel's weighted mean, row-major, top row first (the film's
-    /// `scale` is applied on output, not here).
+    /// `scale` is applied on output, not here). With half buffers, each pixel's mean.
     pub fn pixels(&self) -> Vec<Spectrum> {
+        if let Some(b) = &self.buffers {
+            return b.pixel_stats().iter().map(PixelStats::mean).collect();
+        }
         if self.halves.is_some() {
             return self.per_stream(|f, _| f.pixels());
         }

@@ -22,6 +22,29 @@ pub struct PixelStats {
 }
 
 impl PixelStats {
+    /// The statistics of two disjoint sets of one pixel's samples together, each given as its
+    /// count, mean and sum of squared deviations: Chan et al.'s pairwise combination, in f64.
+    pub fn combined(a: (u32, [f32; 3], [f32; 3]), b: (u32, [f32; 3], [f32; 3])) -> Self {
+        let (na, nb) = (f64::from(a.0), f64::from(b.0));
+        let n = na + nb;
+        if a.0 == 0 || b.0 == 0 {
+            let (count, mean, m2) = if a.0 == 0 { b } else { a };
+            return Self { count, mean, m2 };
+        }
+        let mut out = Self {
+            count: a.0 + b.0,
+            ..Self::default()
+        };
+        for c in 0..3 {
+            let (ma, mb) = (f64::from(a.1[c]), f64::from(b.1[c]));
+            let delta = mb - ma;
+            out.mean[c] = (ma + delta * nb / n) as f32;
+            out.m2[c] =
+                (f64::from(a.2[c]) + f64::from(b.2[c]) + delta * delta * na * nb / n) as f32;
+        }
+        out
+    }
+
     /// Adds one sample's radiance.
     #[inline]
     pub fn add(&mut self, l: Spectrum) {

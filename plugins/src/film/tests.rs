@@ -92,7 +92,7 @@ fn released_sums_leave_the_statistics() {
     f.add_sample(Vec2::new(1.5, 0.5), Spectrum::splat(5.0));
     let stats = f.pixel_stats().to_vec();
     f.release_sums();
-    assert_eq!(f.weighted_sums(), Some(&[][..]));
+    assert_eq!(f.weighted_sums().as_deref(), Some(&[][..]));
     assert!(f.pixels().is_empty());
     assert_eq!(f.pixel_stats(), &stats[..]);
 }
@@ -172,4 +172,86 @@ fn crop_window_edges_round_as_pbrt_v3_computes_them() {
     assert_eq!(s.crop, [320, 481, 160, 241]);
     s.set_crop_window([0.25, 0.5, 0.0, 1.0]).unwrap();
     assert_eq!(s.crop, [200, 400, 0, 400]);
+}
+
+/// A film with half buffers keeps no splats nor statistics of its own, and gives from its
+/// halves what a plain film gives: the counts exactly, the means, variances, image and sums
+/// to f32 rounding; releasing its sums keeps the statistics.
+#[test]
+fn a_film_with_half_buffers_reads_everything_from_them() {
+    use crate::first_hit::FEATURES;
+    use crate::space::SamplePoint;
+    let settings = FilmSettings::with_resolution(3, 2);
+    let mut plain = Film::new(settings.clone(), &BoxFilter::new(0.5, 0.5));
+    let mut halves = Film::new(settings, &BoxFilter::new(0.5, 0.5));
+    halves.keep_pixel_buffers();
+    assert!(halves.sums.is_empty() && halves.stats.is_empty());
+    let (mut batch, mut radiance, mut valid) = (Vec::new(), Vec::new(), Vec::new());
+    for y in 0..2u32 {
+        for x in 0..3u32 {
+            // Pixel (2, 1) gets no sample, pixel (0, 0) one, the others 2 to 7.
+            let n = if (x, y) == (2, 1) {
+                0
+            } else {
+                (x + 3 * y) * 2 % 7 + 1
+            };
+            for i in 0..n {
+                let p = [x as f32 + 0.3 + 0.05 * i as f32, y as f32 + 0.6];
+                let v = 0.1 + ((i * 37 + x * 11 + y * 5) % 13) as f32 * 0.7;
+                batch.push(SamplePoint {
+                    index: i,
+                    film: p,
+                    pixel: [x, y],
+                    ..SamplePoint::UNMADE
+                });
+                radiance.push([v, 2.0 * v, 0.5]);
+                valid.push((Vec2::from(p), Spectrum::new(v, 2.0 * v, 0.5)));
+            }
+        }
+    }
+    let features = vec![[0.5; FEATURES]; batch.len()];
+    for f in [&mut plain, &mut halves] {
+        f.add_points(&batch, &radiance, Some(&features));
+        f.add_samples(&valid);
+    }
+    assert!(halves.sums.is_empty() && halves.stats.is_empty());
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * a.abs().max(1.0);
+    let (a, b) = (plain.pixel_stats(), halves.pixel_stats());
+    for (p, q) in a.iter().zip(b.iter()) {
+        assert_eq!(p.count, q.count);
+        for (u, v) in [
+            (p.mean(), q.mean()),
+            (p.variance_of_mean(), q.variance_of_mean()),
+        ] {
+            assert!(
+                close(u.x, v.x) && close(u.y, v.y) && close(u.z, v.z),
+                "{u:?} {v:?}"
+            );
+        }
+    }
+    assert_eq!(b[0].count, 1);
+    assert_eq!(b[5].count, 0);
+    for (u, v) in plain.pixels().iter().zip(&halves.pixels()) {
+        assert!(
+            close(u.x, v.x) && close(u.y, v.y) && close(u.z, v.z),
+            "{u:?} {v:?}"
+        );
+    }
+    let (sa, sb) = (
+        plain.weighted_sums().expect("sums"),
+        halves.weighted_sums().expect("sums"),
+    );
+    for (u, v) in sa.iter().zip(sb.iter()) {
+        assert_eq!(u[3], v[3]);
+        for c in 0..3 {
+            assert!(
+                (u[c] - v[c]).abs() <= 1e-5 * u[c].abs().max(1.0),
+                "{u:?} {v:?}"
+            );
+        }
+    }
+    let before = halves.pixel_stats().to_vec();
+    halves.release_sums();
+    assert!(halves.pixel_buffers().is_none());
+    assert_eq!(halves.pixel_stats(), &before[..]);
 }

@@ -137,6 +137,7 @@ pub fn filter_pixel_means(film: &Film, kernel: &dyn FilterKernel) -> Vec<Spectru
     let (w, h) = film.settings().size();
     let (w, h) = (w as i64, h as i64);
     let stats = film.pixel_stats();
+    let stats = &*stats;
     let (rx, ry) = kernel.radius();
     let mut taps = Vec::new();
     for dy in -(ry.floor() as i64)..=ry.floor() as i64 {

@@ -264,6 +264,7 @@ impl PolynomialFilter {
         };
         *self.partition.lock().unwrap_or_else(|e| e.into_inner()) = Some(partition);
         let stats = film.pixel_stats();
+        let stats = &*stats;
         (0..h)
             .into_par_iter()
             .flat_map_iter(|py| {

@@ -28,10 +28,8 @@ impl ErrorMap {
     pub fn of(film: &Film, estimate: Option<Vec<f32>>) -> Self {
         let [x0, x1, y0, y1] = film.settings().crop;
         let pixels = (x1 - x0) as usize * (y1 - y0) as usize;
-        let own = film
-            .pixel_stats()
-            .iter()
-            .map(|s| luminance(s.variance_of_mean()));
+        let stats = film.pixel_stats();
+        let own = stats.iter().map(|s| luminance(s.variance_of_mean()));
         // A filter's estimate of its error (NFOR's: the halves' differences less their
         // variances, clamped) is zero wherever its own noise swamps it, most pixels after a
         // short first stage, and those pixels would get no rounds; the variance of the mean,

@@ -43,7 +43,7 @@ pub(super) fn write_image_and_aovs(
             a,
             w as usize,
             h as usize,
-            rendered.film.pixel_stats(),
+            &rendered.film.pixel_stats(),
             job.plugins.sampler.partition(),
             fit_partition.as_ref(),
             rendered.features.as_ref(),
@@ -177,7 +177,7 @@ pub(super) fn report_end(
 /// how to finish it.
 fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> String {
     let spp = rendered.spp;
-    let reached = reached_spp(rendered.film.pixel_stats());
+    let reached = reached_spp(&rendered.film.pixel_stats());
     let resume = if target.out.can_merge {
         // The rest's default footprint is this render's unless the command line chose one.
         let footprint = args

@@ -20,9 +20,10 @@ use crate::first_hit::FEATURES;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
 use acr_parser::{ParamType, Result};
 use nlmeans::{nl_means, Guide};
-use planes::{FeatureHalves, Inputs, Planes};
+use planes::{depth_scale, FeatureHalves, Inputs, Planes, TILE, VARIANCE_RADIUS};
 use regression::Regression;
 use selection::{candidate_mse, select, Candidate, Selected, Smoothing};
+use std::ops::Range;
 
 /// The regression window's radius by default.
 pub const RADIUS: u32 = 3;
@@ -34,6 +35,10 @@ pub const PREFILTER_RADIUS: u32 = 3;
 pub const SELECT_RADIUS: u32 = 3;
 /// The ridge on the slopes, relative to the weights' sum.
 pub const RIDGE: f64 = 1e-3;
+/// The rows of a band by default: the image is filtered a band of rows at a time, each with
+/// a halo of the windows' reach, so that the filter's planes are a band's, not the image's
+/// (docs/reconstruction.md, "Memory").
+pub const BAND: u32 = 256;
 /// The NL-means bandwidths of the regression's candidates. NFOR's are 0.5 and 1 with a
 /// variance shared by the halves; with each half's own (unbiased) variance, 1 and 2 measured
 /// lower (docs/reconstruction.md).
@@ -60,6 +65,8 @@ pub struct NforFilter {
     ridge: f32,
     /// Whether NFOR's second pass runs.
     second_pass: bool,
+    /// The rows of a band (0: the whole image at once).
+    band: usize,
     /// The film keeps pixel statistics only: a box of one pixel.
     kernel: BoxFilter,
 }
@@ -80,6 +87,7 @@ impl NforFilter {
             select_radius: select as usize,
             ridge: ridge as f32,
             second_pass: true,
+            band: BAND as usize,
             kernel: BoxFilter::new(0.5, 0.5),
         }
     }
@@ -90,10 +98,71 @@ impl NforFilter {
         self
     }
 
-    /// The filtered image and its estimated per-pixel MSE, with the bandwidths `ks`; with
-    /// `second`, the second pass too.
-    fn denoise(&self, b: &PixelBuffers, ks: &[f32], second: bool) -> (Planes, Vec<f32>) {
-        let (inp, feats) = Inputs::read(b);
+    /// The filter with bands of `rows` rows (0: the whole image at once).
+    pub fn with_band(mut self, rows: u32) -> Self {
+        self.band = rows as usize;
+        self
+    }
+
+    /// How far, in pixels, the filtered value of a pixel reaches into its inputs: the sum of
+    /// each step's windows (features prefiltered, the collaborative regression, the two
+    /// smoothings of the choice, the second pass).
+    fn reach(&self, second: bool) -> usize {
+        let (r, p) = (self.radius, self.patch);
+        let prefiltered = self.prefilter_radius + p;
+        // Each fit reads its window's features and guide patches; its predictions go a
+        // window further.
+        let fits = 2 * r + prefiltered.max(p + VARIANCE_RADIUS as usize);
+        // The choice's two NL-means smoothings have a patch of 1.
+        let first = fits + 2 * (self.select_radius + 1);
+        if second {
+            2 * r + p + first
+        } else {
+            first
+        }
+    }
+
+    /// The filtered image and its estimated per-pixel MSE (bandwidths `ks`; with `second`,
+    /// the second pass too), band by band: `take` gets each band's image and MSE (over the
+    /// band's rows with their halo) and the band's own rows within them, top band first.
+    /// Each band's halo covers [`NforFilter::reach`] and band and halo start on the tile grid,
+    /// so every pixel is computed as from the whole image, byte for byte.
+    fn by_bands(
+        &self,
+        b: &PixelBuffers,
+        ks: &[f32],
+        second: bool,
+        mut take: impl FnMut(&Planes, &[f32], Range<usize>),
+    ) {
+        let h = b.size().1 as usize;
+        let depth = depth_scale(b);
+        let band = match self.band {
+            0 => h.max(1),
+            n => n.next_multiple_of(TILE),
+        };
+        let halo = self.reach(second).next_multiple_of(TILE);
+        let mut y = 0;
+        while y < h {
+            // A remainder within the halo joins its band: those rows are read anyway.
+            let end = if y + band + halo >= h { h } else { y + band };
+            let rows = y.saturating_sub(halo)..(end + halo).min(h);
+            let (image, mse) = self.denoise(b, rows.clone(), depth, ks, second);
+            take(&image, &mse, y - rows.start..end - rows.start);
+            y = end;
+        }
+    }
+
+    /// The filtered image and its estimated per-pixel MSE over the buffers' rows `rows`, as if
+    /// they were the whole image (depth scaled by `depth`).
+    fn denoise(
+        &self,
+        b: &PixelBuffers,
+        rows: Range<usize>,
+        depth: f32,
+        ks: &[f32],
+        second: bool,
+    ) -> (Planes, Vec<f32>) {
+        let (inp, feats) = Inputs::read(b, rows, depth);
         let hit = &inp.hit;
         // Features prefiltered across the halves: each half's features averaged with
         // weights from the other half's.
@@ -238,18 +307,27 @@ impl Filter for NforFilter {
             // A film without half buffers (a stream's own film): its pixel means.
             return film.pixel_stats().iter().map(|s| s.mean()).collect();
         };
-        let (image, _) = self.denoise(b, &BANDWIDTHS, self.second_pass);
-        image
-            .data
-            .chunks(3)
-            .map(|c| Spectrum::new(c[0], c[1], c[2]).max(Spectrum::ZERO))
-            .collect()
+        let (w, h) = b.size();
+        let mut out = Vec::with_capacity(w as usize * h as usize);
+        self.by_bands(b, &BANDWIDTHS, self.second_pass, |image, _, rows| {
+            let span = &image.data[rows.start * image.w * 3..rows.end * image.w * 3];
+            out.extend(
+                span.chunks(3)
+                    .map(|c| Spectrum::new(c[0], c[1], c[2]).max(Spectrum::ZERO)),
+            );
+        });
+        out
     }
 
     fn estimated_error(&self, film: &Film) -> Option<Vec<f32>> {
         // One bandwidth: half the regression's cost, for a sampler that asks mid-render.
-        film.pixel_buffers()
-            .map(|b| self.denoise(b, &BANDWIDTHS[..1], false).1)
+        let b = film.pixel_buffers()?;
+        let (w, h) = b.size();
+        let mut out = Vec::with_capacity(w as usize * h as usize);
+        self.by_bands(b, &BANDWIDTHS[..1], false, |_, mse, rows| {
+            out.extend_from_slice(&mse[rows.start * w as usize..rows.end * w as usize]);
+        });
+        Some(out)
     }
 }
 
@@ -293,6 +371,13 @@ pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
                 "the radius of the window smoothing the MSE estimates and the per-pixel choice",
             ),
             ParamSpec::new(
+                "band",
+                ParamType::Integer,
+                "256",
+                "rows filtered at a time, each band with a halo of the windows' reach: less \
+                 memory, more time; the image is the same (0: the whole image at once)",
+            ),
+            ParamSpec::new(
                 "ridge",
                 ParamType::Float,
                 "0.001",
@@ -313,7 +398,8 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
             int_in(p, "selectradius", SELECT_RADIUS as i32, 0..=16)?,
             float_in(p, "ridge", RIDGE, 0.0..=1e3)?,
         )
-        .with_second_pass(p.bool_or("secondpass", true)?),
+        .with_second_pass(p.bool_or("secondpass", true)?)
+        .with_band(int_in(p, "band", BAND as i32, 0..=1 << 16)?),
     ))
 }
 

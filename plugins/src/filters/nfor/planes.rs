@@ -128,7 +128,7 @@ pub(crate) struct Inputs {
 }
 
 /// The radius of the box that steadies the halves' variance estimates.
-const VARIANCE_RADIUS: i64 = 1;
+pub(crate) const VARIANCE_RADIUS: i64 = 1;
 
 /// `img` averaged over each pixel's neighbours within `r` pixels of the same `group`.
 fn box_in_group(img: &Planes, group: &[bool], r: i64) -> Planes {
@@ -180,26 +180,39 @@ fn half_variance<const N: usize>(
     }
 }
 
-impl Inputs {
-    /// Reads the buffers. A half without samples takes the other half's values.
-    pub fn read(b: &PixelBuffers) -> (Self, FeatureHalves) {
-        let (w, h) = b.size();
-        let (w, h) = (w as usize, h as usize);
-        let n = w * h;
-        let [a, bb] = [b.half(0), b.half(1)];
-        // Depth on the scale of the image's mean depth, so that one ridge suits every scene.
-        let (mut dsum, mut dcount) = (0.0f64, 0u64);
-        for p in a.iter().chain(bb) {
-            if p.count > 0 && p.features[DEPTH] > 0.0 {
-                dsum += f64::from(p.features[DEPTH]);
-                dcount += 1;
-            }
+/// The factor that brings depth to the scale of the image's mean depth (over both halves of
+/// every pixel with a first hit), so that one ridge suits every scene: computed over the whole
+/// image, whatever part of it is filtered.
+pub(crate) fn depth_scale(b: &PixelBuffers) -> f32 {
+    let (mut dsum, mut dcount) = (0.0f64, 0u64);
+    for p in b.half(0).iter().chain(b.half(1)) {
+        let depth = p.features()[DEPTH];
+        if p.count > 0 && depth > 0.0 {
+            dsum += f64::from(depth);
+            dcount += 1;
         }
-        let depth_scale = if dsum > 0.0 {
-            (dcount as f64 / dsum) as f32
-        } else {
-            1.0
-        };
+    }
+    if dsum > 0.0 {
+        (dcount as f64 / dsum) as f32
+    } else {
+        1.0
+    }
+}
+
+impl Inputs {
+    /// Reads the buffers' rows `rows` (an image of their full width and `rows.len()` rows),
+    /// with depth times `depth_scale` ([`depth_scale`]). A half without samples takes the
+    /// other half's values.
+    pub fn read(
+        b: &PixelBuffers,
+        rows: std::ops::Range<usize>,
+        depth_scale: f32,
+    ) -> (Self, FeatureHalves) {
+        let w = b.size().0 as usize;
+        let h = rows.len();
+        let n = w * h;
+        let span = rows.start * w..rows.end * w;
+        let [a, bb] = [&b.half(0)[span.clone()], &b.half(1)[span]];
         let mut inp = Inputs {
             color: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
             color_var: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
@@ -248,7 +261,8 @@ impl Inputs {
             (pa.count, pa.color_variance_of_mean()),
             cdiff,
         );
-        let fdiff: [f32; FEATURES] = std::array::from_fn(|k| pa.features[k] - pb.features[k]);
+        let (ma, mb) = (pa.features(), pb.features());
+        let fdiff: [f32; FEATURES] = std::array::from_fn(|k| ma[k] - mb[k]);
         let fa = half_variance(
             (pa.count, pa.features_variance_of_mean()),
             (pb.count, pb.features_variance_of_mean()),
@@ -277,11 +291,11 @@ impl Inputs {
         let scale = |k: usize| if k == DEPTH { depth_scale } else { 1.0 };
         for k in 0..FEATURES {
             let s = scale(k);
-            feats.features[0].px_mut(i)[k] = pa.features[k] * s;
-            feats.features[1].px_mut(i)[k] = pb.features[k] * s;
+            feats.features[0].px_mut(i)[k] = ma[k] * s;
+            feats.features[1].px_mut(i)[k] = mb[k] * s;
             feats.variance[0].px_mut(i)[k] = fa[k] * s * s;
             feats.variance[1].px_mut(i)[k] = fb[k] * s * s;
         }
-        self.hit[i] = pa.features.iter().chain(&pb.features).any(|&f| f != 0.0);
+        self.hit[i] = ma.iter().chain(&mb).any(|&f| f != 0.0);
     }
 }

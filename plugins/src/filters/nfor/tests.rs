@@ -157,3 +157,46 @@ fn a_splatting_film_gives_its_pixel_means() {
     assert_eq!(out[1], Spectrum::ONE);
     assert_eq!(out[0], Spectrum::ZERO);
 }
+
+#[test]
+fn bands_give_the_whole_images_bytes() {
+    // Rows of different kinds (walls, a second surface, an emitter) and noise, tall enough
+    // for five bands of 32 rows with their halo: every pixel, its estimated error too, must
+    // come out as from the whole image at once.
+    let (w, h) = (24, 150);
+    let film = film(w, h, 4, |x, y, i| {
+        let v = hash(((y * w + x) << 3) + i) * if (x + y / 7) % 9 > 4 { 2.0 } else { 0.5 };
+        match (y / 11) % 4 {
+            0 => Some(([4.0, 4.0, 4.0], [0.0; 7])),
+            1 => Some((
+                [v, v * 0.5, 0.1],
+                [0.2, 0.8, 0.1, 0.0, 1.0, 0.0, 5.0 + y as f32],
+            )),
+            _ => Some(([v, v, v * 2.0], WALL)),
+        }
+    });
+    let bits = |v: &[Spectrum]| -> Vec<u32> {
+        v.iter()
+            .flat_map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
+            .collect()
+    };
+    // The default windows, with and without the second pass, and wider ones (a halo of two
+    // tiles).
+    let wider = || NforFilter::new(5, 2, 4, 2, RIDGE);
+    for (filter, second) in [
+        (NforFilter::default as fn() -> NforFilter, true),
+        (NforFilter::default, false),
+        (wider, true),
+    ] {
+        let whole = filter().with_second_pass(second).with_band(0);
+        let banded = filter().with_second_pass(second).with_band(1);
+        let a = reconstruct(&whole, &film);
+        let b = reconstruct(&banded, &film);
+        assert_eq!(b.len(), (w * h) as usize);
+        assert_eq!(bits(&a), bits(&b), "second pass {second}");
+        let ea = whole.estimated_error(&film).expect("an estimate");
+        let eb = banded.estimated_error(&film).expect("an estimate");
+        let fb = |v: &[f32]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
+        assert_eq!(fb(&ea), fb(&eb));
+    }
+}
