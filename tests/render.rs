@@ -759,6 +759,9 @@ fn subsurface_furnace_creates_no_energy() {
             .map(|i| r.pixels[i])
             .collect();
         let m = mean(&centre);
-        assert!(m.is_finite() && m.min_element() > lo && m.max_element() < hi, "Kd {kd}: {m}");
+        assert!(
+            m.is_finite() && m.min_element() > lo && m.max_element() < hi,
+            "Kd {kd}: {m}"
+        );
     }
 }

@@ -25,6 +25,9 @@ pub struct TabulatedBssrdf<'a> {
     pub rho: Spectrum,
     /// The profile table.
     pub table: &'a BssrdfTable,
+    /// Each channel's sampling radius bound (its 0.999 quantile), when known in advance (a
+    /// material with constant coefficients computes it once): `None` computes it per sample.
+    pub r_max: Option<[Option<f32>; 3]>,
 }
 
 /// A probe segment and what is left of the sample that chose it.
@@ -50,6 +53,19 @@ impl<'a> TabulatedBssrdf<'a> {
         sigma_s: Spectrum,
         table: &'a BssrdfTable,
     ) -> Self {
+        let frame = Frame::from_xz(si.shading_dpdu, si.shading_n);
+        Self::with_frame(si.p, frame, eta, sigma_a, sigma_s, table)
+    }
+
+    /// [`Self::new`] at point `po` with shading frame `frame`.
+    pub fn with_frame(
+        po: Vec3,
+        frame: Frame,
+        eta: f32,
+        sigma_a: Spectrum,
+        sigma_s: Spectrum,
+        table: &'a BssrdfTable,
+    ) -> Self {
         let clean = |s: Spectrum| {
             Spectrum::from_array(
                 s.to_array()
@@ -69,21 +85,38 @@ impl<'a> TabulatedBssrdf<'a> {
             rho[c] = if r.is_finite() { r } else { 0.0 };
         }
         Self {
-            po: si.p,
-            frame: Frame::from_xz(si.shading_dpdu, si.shading_n),
+            po,
+            frame,
             eta,
             sigma_t,
             rho,
             table,
+            r_max: None,
         }
+    }
+
+    /// Each channel's sampling radius bound ([`Self::sample_sr`] at 0.999), for
+    /// [`Self::r_max`].
+    pub fn radius_bounds(&self) -> [Option<f32>; 3] {
+        [0, 1, 2].map(|ch| self.sample_sr(ch, 0.999))
     }
 
     /// Spline weights of channel `ch` at optical radius `r_optical`, and the effective albedo
     /// interpolated by its rho weights (`None` outside the table, as pbrt-v3's weights fail).
     #[inline]
     fn interpolate(&self, ch: usize, r_optical: f32) -> Option<(f32, f32)> {
+        let rho = catmull_rom_weights(&self.table.rho_samples, self.rho[ch])?;
+        self.interpolate_with(rho, r_optical)
+    }
+
+    /// [`Self::interpolate`] with the channel's albedo weights already found.
+    #[inline]
+    fn interpolate_with(
+        &self,
+        (rho_off, rho_w): (isize, [f32; 4]),
+        r_optical: f32,
+    ) -> Option<(f32, f32)> {
         let t = self.table;
-        let (rho_off, rho_w) = catmull_rom_weights(&t.rho_samples, self.rho[ch])?;
         let (rad_off, rad_w) = catmull_rom_weights(&t.radius_samples, r_optical)?;
         let (mut sr, mut rho_eff) = (0.0f32, 0.0f32);
         for (i, &wi) in rho_w.iter().enumerate() {
@@ -144,8 +177,17 @@ impl<'a> TabulatedBssrdf<'a> {
     /// pbrt-v3's `Pdf_Sr`: the density of radius `r` under [`Self::sample_sr`] for channel
     /// `ch`, per unit area of the plane.
     pub fn pdf_sr(&self, ch: usize, r: f32) -> f32 {
+        match catmull_rom_weights(&self.table.rho_samples, self.rho[ch]) {
+            Some(rho) => self.pdf_sr_with(ch, rho, r),
+            None => 0.0,
+        }
+    }
+
+    /// [`Self::pdf_sr`] with the channel's albedo weights already found.
+    #[inline]
+    fn pdf_sr_with(&self, ch: usize, rho: (isize, [f32; 4]), r: f32) -> f32 {
         let st = self.sigma_t[ch];
-        match self.interpolate(ch, r * st) {
+        match self.interpolate_with(rho, r * st) {
             Some((sr, rho_eff)) => {
                 let p = sr * st * st / rho_eff;
                 if p.is_finite() {
@@ -175,7 +217,10 @@ impl<'a> TabulatedBssrdf<'a> {
         u1 = u1 * 3.0 - ch as f32;
         let r = self.sample_sr(ch, u2.x)?;
         let phi = 2.0 * PI * u2.y;
-        let r_max = self.sample_sr(ch, 0.999)?;
+        let r_max = match self.r_max {
+            Some(bounds) => bounds[ch]?,
+            None => self.sample_sr(ch, 0.999)?,
+        };
         if r >= r_max {
             return None;
         }
@@ -202,9 +247,15 @@ impl<'a> TabulatedBssrdf<'a> {
         let axis_prob = [0.25f32, 0.25, 0.5];
         let n_local = [n.x, n.y, n.z];
         let mut pdf = 0.0f32;
-        for axis in 0..3 {
-            for ch in 0..3 {
-                pdf += self.pdf_sr(ch, r_proj[axis]) * n_local[axis].abs() * axis_prob[axis] / 3.0;
+        // Channel-major: each channel's albedo weights found once for the three axes.
+        for ch in 0..3 {
+            let Some(rho) = catmull_rom_weights(&self.table.rho_samples, self.rho[ch]) else {
+                continue;
+            };
+            for axis in 0..3 {
+                pdf +=
+                    self.pdf_sr_with(ch, rho, r_proj[axis]) * n_local[axis].abs() * axis_prob[axis]
+                        / 3.0;
             }
         }
         pdf

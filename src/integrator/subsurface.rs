@@ -6,9 +6,8 @@
 //! sample of that BSDF. Kept apart from `path` so that `volpath` can call it too.
 
 use super::{next_event, LastScatter, MAX_PASS_THROUGH};
-use crate::accel::Hit;
 use crate::bssrdf::{adapter_bsdf, TabulatedBssrdf};
-use crate::geometry::{is_valid_radiance, Ray, Spectrum};
+use crate::geometry::{is_valid_radiance, Ray, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -38,7 +37,7 @@ pub(super) fn scatter(
     let probe = bssrdf.probe(u1, u2)?;
     // Every surface of the same material along the segment (pbrt-v3 compares material
     // pointers; acr's materials are indices). Other surfaces are crossed.
-    let mut found: Vec<(Ray, Hit)> = Vec::new();
+    let mut found: Vec<SurfaceInteraction> = Vec::new();
     let mut ray = Ray::new(probe.start, probe.end - probe.start, time);
     let mut t_max = 1.0 - crate::geometry::SHADOW_EPSILON;
     for _ in 0..MAX_PASS_THROUGH {
@@ -50,18 +49,17 @@ pub(super) fn scatter(
             break;
         };
         let si = scene.accel.interaction(&ray, &hit);
-        if scene.surfaces[hit.prim.surface as usize].material == Some(material) {
-            found.push((ray, hit));
-        }
         (ray, t_max) = si.spawn_ray_to(probe.end);
+        if scene.surfaces[hit.prim.surface as usize].material == Some(material) {
+            found.push(si);
+        }
     }
     if found.is_empty() {
         return None;
     }
     let n = found.len();
     let chosen = ((probe.u_choice * n as f32) as usize).min(n - 1);
-    let (r, h) = &found[chosen];
-    let mut pi = scene.accel.interaction(r, h);
+    let mut pi = found[chosen];
     let pdf = bssrdf.pdf_sp(pi.p, pi.n) / n as f32;
     let sp = bssrdf.sp(pi.p);
     if sp == Spectrum::ZERO || !(pdf > 0.0) {

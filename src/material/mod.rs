@@ -24,8 +24,8 @@ pub mod metal;
 pub mod mirror;
 pub mod plastic;
 mod shared;
-pub mod subsurface;
 pub mod substrate;
+pub mod subsurface;
 pub mod translucent;
 pub mod uber;
 

@@ -46,6 +46,17 @@ pub struct Subsurface {
     pub coefficients: Coefficients,
     /// The profile table for this material's g and eta (shared by equal materials).
     pub table: Arc<BssrdfTable>,
+    /// With constant coefficients: σa, σs and the sampling radius bounds, found once (the
+    /// kdsubsurface inversion and the bound's spline sampling otherwise run at every hit).
+    fixed: Option<Fixed>,
+}
+
+/// What a material with constant coefficients computes once.
+#[derive(Clone, Copy, Debug)]
+struct Fixed {
+    sigma_a: Spectrum,
+    sigma_s: Spectrum,
+    r_max: [Option<f32>; 3],
 }
 
 /// pbrt-v3's default `subsurface` coefficients (its `Wholemilk` measurement), in mm⁻¹.
@@ -116,13 +127,44 @@ impl Subsurface {
             v_roughness: t.float_param(p, "vroughness", 0.0)?,
             remap_roughness: remap_roughness(p)?,
         };
-        Ok(Self {
+        let mut m = Self {
             surface,
             eta,
             scale,
             coefficients,
             table: table_for(g, eta),
-        })
+            fixed: None,
+        };
+        let constant = match &m.coefficients {
+            Coefficients::Direct { sigma_a, sigma_s } => {
+                sigma_a.as_constant().zip(sigma_s.as_constant())
+            }
+            Coefficients::Diffuse { kd, mfp } => kd.as_constant().zip(mfp.as_constant()),
+        };
+        if let Some((a, b)) = constant {
+            let (sigma_a, sigma_s) = m.coefficients_from(a, b);
+            let frame = crate::geometry::Frame::from_z(crate::geometry::Vec3::Z);
+            let r_max =
+                TabulatedBssrdf::with_frame(frame.n, frame, eta, sigma_a, sigma_s, &m.table)
+                    .radius_bounds();
+            m.fixed = Some(Fixed {
+                sigma_a,
+                sigma_s,
+                r_max,
+            });
+        }
+        Ok(m)
+    }
+
+    /// σa and σs from the two coefficient values evaluated at a hit (σa and σs, or Kd and
+    /// mfp), with pbrt-v3's clamps and scale.
+    fn coefficients_from(&self, a: Spectrum, b: Spectrum) -> (Spectrum, Spectrum) {
+        match self.coefficients {
+            Coefficients::Direct { .. } => (self.scale * clamp0(a), self.scale * clamp0(b)),
+            Coefficients::Diffuse { .. } => self
+                .table
+                .subsurface_from_diffuse(clamp0(a), self.scale * clamp0(b)),
+        }
     }
 
     /// Adds the boundary's lobes (pbrt-v3's dielectric: one `FresnelSpecular` where smooth and
@@ -142,17 +184,16 @@ impl Subsurface {
 
     /// The BSSRDF at (shaded) hit `si`: the coefficients evaluated there, clamped at zero.
     pub fn bssrdf(&self, si: &SurfaceInteraction) -> TabulatedBssrdf<'_> {
-        let (sigma_a, sigma_s) = match &self.coefficients {
-            Coefficients::Direct { sigma_a, sigma_s } => (
-                self.scale * clamp0(sigma_a.eval(si)),
-                self.scale * clamp0(sigma_s.eval(si)),
-            ),
-            Coefficients::Diffuse { kd, mfp } => {
-                let mfree = self.scale * clamp0(mfp.eval(si));
-                self.table
-                    .subsurface_from_diffuse(clamp0(kd.eval(si)), mfree)
-            }
+        if let Some(f) = &self.fixed {
+            let mut b = TabulatedBssrdf::new(si, self.eta, f.sigma_a, f.sigma_s, &self.table);
+            b.r_max = Some(f.r_max);
+            return b;
+        }
+        let (a, b) = match &self.coefficients {
+            Coefficients::Direct { sigma_a, sigma_s } => (sigma_a.eval(si), sigma_s.eval(si)),
+            Coefficients::Diffuse { kd, mfp } => (kd.eval(si), mfp.eval(si)),
         };
+        let (sigma_a, sigma_s) = self.coefficients_from(a, b);
         TabulatedBssrdf::new(si, self.eta, sigma_a, sigma_s, &self.table)
     }
 }

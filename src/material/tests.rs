@@ -391,7 +391,11 @@ fn subsurface_materials_build_with_pbrt_v3_parameters() {
     let b = m.last().unwrap().bssrdf(&si()).unwrap();
     // Skin1's coefficients times the scale; g forced to 0 by the name (its table is g = 0's).
     let (a, s) = crate::bssrdf::measured::lookup("Skin1").unwrap();
-    assert!((b.sigma_t - 2.0 * (a + s)).abs().max_element() < 1e-6, "{}", b.sigma_t);
+    assert!(
+        (b.sigma_t - 2.0 * (a + s)).abs().max_element() < 1e-6,
+        "{}",
+        b.sigma_t
+    );
     assert!(std::ptr::eq(b.table, &*crate::bssrdf::table_for(0.0, 1.33)));
     // The boundary: one FresnelSpecular, index 1.33.
     let bsdf = m.last().unwrap().bsdf(&si());
@@ -406,7 +410,12 @@ fn subsurface_materials_build_with_pbrt_v3_parameters() {
     ));
     assert!(w.is_empty(), "{w:?}");
     let b = m.last().unwrap().bssrdf(&si()).unwrap();
-    assert!((b.sigma_t - Spectrum::new(1.0, 2.0, 0.5)).abs().max_element() < 1e-4);
+    assert!(
+        (b.sigma_t - Spectrum::new(1.0, 2.0, 0.5))
+            .abs()
+            .max_element()
+            < 1e-4
+    );
     // A bumped subsurface keeps its BSSRDF; other materials have none.
     let (m, _) = build(&format!(
         "Texture \"bump\" \"float\" \"constant\"\nMaterial \"kdsubsurface\" \"texture bumpmap\" \"bump\"\n{SHAPE}\nMaterial \"matte\"\n{SHAPE}"
@@ -419,7 +428,10 @@ fn subsurface_materials_build_with_pbrt_v3_parameters() {
         "Material \"subsurface\" \"string name\" \"Ketchp\"\n{SHAPE}"
     ));
     assert_eq!(w.len(), 1, "{w:?}");
-    assert!(w[0].message.contains("Ketchup") && w[0].loc.is_some(), "{w:?}");
+    assert!(
+        w[0].message.contains("Ketchup") && w[0].loc.is_some(),
+        "{w:?}"
+    );
     assert!(m.last().unwrap().bssrdf(&si()).is_some());
     // Negative coefficients: a located warning, clamped as pbrt-v3 clamps them.
     let (m, w) = build(&format!(
@@ -430,7 +442,11 @@ fn subsurface_materials_build_with_pbrt_v3_parameters() {
     let b = m.last().unwrap().bssrdf(&si()).unwrap();
     assert!(b.sigma_t.x >= 0.0 && b.sigma_t.is_finite());
     // Parameters the table cannot take: located errors.
-    for bad in ["\"float eta\" [0.9]", "\"float g\" [1]", "\"float scale\" [-2]"] {
+    for bad in [
+        "\"float eta\" [0.9]",
+        "\"float g\" [1]",
+        "\"float scale\" [-2]",
+    ] {
         let e = build_err(&format!("Material \"kdsubsurface\" {bad}\n{SHAPE}"));
         assert!(matches!(e, Error::At { .. }), "{bad}: {e}");
     }
