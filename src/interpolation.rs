@@ -176,9 +176,10 @@ pub fn integrate_catmull_rom(x: &[f32], values: &[f32], cdf: &mut [f32]) -> f32 
 /// `u` (clamped to the first or last node outside their range; NaN gives the first).
 pub fn invert_catmull_rom(x: &[f32], values: &[f32], u: f32) -> f32 {
     let n = x.len();
-    if !(u > values[0]) {
+    use std::cmp::Ordering::{Greater, Less};
+    if u.partial_cmp(&values[0]) != Some(Greater) {
         return x[0];
-    } else if !(u < values[n - 1]) {
+    } else if u.partial_cmp(&values[n - 1]) != Some(Less) {
         return x[n - 1];
     }
     let i = find_interval(n, |i| values[i] <= u);

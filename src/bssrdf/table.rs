@@ -170,10 +170,13 @@ impl BssrdfTable {
     }
 }
 
+/// The tables built so far, by the bits of (g, eta).
+type Tables = HashMap<(u32, u32), Arc<BssrdfTable>>;
+
 /// The table for (`g`, `eta`), built on first request and shared after (several materials
 /// with the same g and eta share one; pbrt-v3 builds one per material).
 pub fn table_for(g: f32, eta: f32) -> Arc<BssrdfTable> {
-    static CACHE: OnceLock<Mutex<HashMap<(u32, u32), Arc<BssrdfTable>>>> = OnceLock::new();
+    static CACHE: OnceLock<Mutex<Tables>> = OnceLock::new();
     let cache = CACHE.get_or_init(Default::default);
     let key = (g.to_bits(), eta.to_bits());
     if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {

@@ -62,7 +62,7 @@ pub(super) fn scatter(
     let mut pi = found[chosen];
     let pdf = bssrdf.pdf_sp(pi.p, pi.n) / n as f32;
     let sp = bssrdf.sp(pi.p);
-    if sp == Spectrum::ZERO || !(pdf > 0.0) {
+    if sp == Spectrum::ZERO || pdf.is_nan() || pdf <= 0.0 {
         return None;
     }
     *beta *= sp / pdf;
