@@ -765,3 +765,26 @@ fn subsurface_furnace_creates_no_energy() {
         );
     }
 }
+
+/// Coefficients that overflow (a scale texture of 1e30 x 1e30 is infinite) or a zero mean free
+/// path (infinite extinction) give a finite image: such channels scatter nothing
+/// (docs/subsurface.md, "Bad input").
+#[test]
+fn subsurface_with_infinite_coefficients_gives_a_finite_image() {
+    let text = "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [40]\n\
+        Film \"image\" \"integer xresolution\" [16] \"integer yresolution\" [16]\n\
+        WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+        Texture \"big\" \"spectrum\" \"scale\" \"rgb tex1\" [1e30 1 1] \"rgb tex2\" [1e30 1 1]\n\
+        AttributeBegin\nTranslate -1 0 0\nMaterial \"subsurface\" \"texture sigma_s\" \"big\"\n\
+        Shape \"sphere\" \"float radius\" [0.9]\nAttributeEnd\n\
+        AttributeBegin\nTranslate 1 0 0\nMaterial \"kdsubsurface\" \"rgb mfp\" [0 1 1]\n\
+        Shape \"sphere\" \"float radius\" [0.9]\nAttributeEnd\nWorldEnd";
+    let desc = parse_str(text, Path::new("bad-subsurface.pbrt")).unwrap();
+    let r = render_desc(&desc, 16, 2);
+    assert_eq!(r.dropped, 0);
+    assert!(r
+        .pixels
+        .iter()
+        .all(|p| p.is_finite() && p.min_element() >= 0.0));
+    assert!(acr::spectrum_luminance(mean(&r.pixels)) > 0.1);
+}

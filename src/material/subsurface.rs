@@ -71,12 +71,11 @@ impl Subsurface {
     /// `remaproughness`. Warnings (an unknown name, negative coefficients) go to `t`.
     pub fn from_params(t: &mut TextureBuilder, p: &ParamList, loc: &Loc) -> Result<Self> {
         let (mut sig_a, mut sig_s) = (DEFAULT_SIGMA_A, DEFAULT_SIGMA_S);
-        let mut g = checked(p, "g", 0.0, loc, |g| g > -1.0 && g < 1.0, "in (-1, 1)")?;
+        let mut measurement = false;
         if let Some(name) = p.string("name")? {
             let at = p.get("name").map_or(loc, |q| &q.loc);
             match measured::lookup(name) {
-                // The measurements are reduced coefficients: pbrt-v3 sets g to 0.
-                Some((a, s)) => (sig_a, sig_s, g) = (a, s, 0.0),
+                Some((a, s)) => (sig_a, sig_s, measurement) = (a, s, true),
                 None if !name.is_empty() => {
                     let hint = acr_parser::closest(name, measured::names())
                         .map_or(String::new(), |n| format!(" (did you mean \"{n}\"?)"));
@@ -92,6 +91,13 @@ impl Subsurface {
                 None => {}
             }
         }
+        // The measurements are reduced coefficients: pbrt-v3 sets g to 0 (whatever is given).
+        let g = if measurement {
+            p.get("g");
+            0.0
+        } else {
+            checked(p, "g", 0.0, loc, |g| g > -1.0 && g < 1.0, "in (-1, 1)")?
+        };
         let sigma_a = t.spectrum_param(p, "sigma_a", sig_a)?;
         let sigma_s = t.spectrum_param(p, "sigma_s", sig_s)?;
         warn_negative(t, p, &["sigma_a", "sigma_s"]);
