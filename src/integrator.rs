@@ -5,6 +5,9 @@
 //! in how: the BSDF sample that continues the path also serves as the BSDF half of the MIS pair
 //! for emission it hits (as pbrt-v4 does), where pbrt-v3 traces a separate ray for it. Same
 //! expectation, one ray fewer per bounce.
+//!
+//! A path transmitted into a subsurface material leaves from an exit point that
+//! the step in `src/integrator/subsurface.rs` finds (docs/subsurface.md).
 
 use crate::first_hit::{FirstHit, FirstHitProbe};
 use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction, Vec3};
