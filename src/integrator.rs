@@ -5,6 +5,9 @@
 //! in how: the BSDF sample that continues the path also serves as the BSDF half of the MIS pair
 //! for emission it hits (as pbrt-v4 does), where pbrt-v3 traces a separate ray for it. Same
 //! expectation, one ray fewer per bounce.
+//!
+//! A path transmitted into a subsurface material leaves from an exit point that
+//! the step in `src/integrator/subsurface.rs` finds (docs/subsurface.md).
 
 use crate::first_hit::{FirstHit, FirstHitProbe};
 use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction, Vec3};
@@ -15,6 +18,8 @@ use crate::scene::Scene;
 use crate::stream::SampleStream;
 use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
+
+mod subsurface;
 
 /// Most consecutive pass-through surfaces (`Material ""`) a ray may cross before it is
 /// abandoned: a guard against a ray trapped between coincident interfaces.
@@ -384,6 +389,7 @@ fn path_li(
         if depth >= max_depth {
             break;
         }
+        let material_index = material;
         let material = &scene.materials[material as usize];
         let si = material.shading(&si);
         let bsdf = material.bsdf(&si);
@@ -425,6 +431,23 @@ fn path_li(
         last.p = si.p;
         last.bsdf_pdf = if s.specular { 0.0 } else { s.pdf };
         ray = si.spawn_ray(s.wi);
+        // Transmitted into a subsurface material: the path leaves from an exit point instead.
+        if let Some(bssrdf) = transmitted.then(|| material.bssrdf(&si)).flatten() {
+            let exit = subsurface::scatter(
+                scene,
+                &bssrdf,
+                material_index,
+                si.time,
+                light_strategy,
+                stream,
+                &mut beta,
+                &mut l,
+                &mut last,
+                &mut rays,
+            );
+            let Some(next) = exit else { break };
+            ray = next;
+        }
         depth += 1;
         let rr_beta = beta * eta_scale;
         let m = rr_beta.max_element();

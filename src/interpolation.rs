@@ -1,6 +1,7 @@
 //! pbrt-v3's spline and Fourier interpolation (`core/interpolation.cpp`), for the tabulated
-//! `fourier` BSDF: Catmull-Rom weights and sampling of a 2D spline table, Fourier series
-//! evaluation and sampling. Same operations in the same precision (f32, f64 where pbrt-v3
+//! `fourier` BSDF and the subsurface profiles of [`crate::bssrdf`]: Catmull-Rom weights,
+//! integration, inversion and sampling of a 2D spline table, Fourier series evaluation and
+//! sampling. Same operations in the same precision (f32, f64 where pbrt-v3
 //! uses double), so that values match.
 
 use std::f64::consts::PI;
@@ -136,6 +137,84 @@ pub fn sample_catmull_rom_2d(
     Some((x0 + width * t, f, f / maximum))
 }
 
+/// Finite-difference derivatives of spline segment `i` of `values` over `x`, scaled to the
+/// segment's width (pbrt-v3's, shared by its integration and inversion).
+fn segment_derivatives(x: &[f32], values: &[f32], i: usize) -> (f32, f32) {
+    let n = x.len();
+    let (x0, x1) = (x[i], x[i + 1]);
+    let (f0, f1) = (values[i], values[i + 1]);
+    let width = x1 - x0;
+    let d0 = if i > 0 {
+        width * (f1 - values[i - 1]) / (x1 - x[i - 1])
+    } else {
+        f1 - f0
+    };
+    let d1 = if i + 2 < n {
+        width * (values[i + 2] - f0) / (x[i + 2] - x0)
+    } else {
+        f1 - f0
+    };
+    (d0, d1)
+}
+
+/// pbrt-v3's `IntegrateCatmullRom`: the integral of the spline through (`x`, `values`), with
+/// its running integral at each node written to `cdf` (`cdf[0]` = 0).
+pub fn integrate_catmull_rom(x: &[f32], values: &[f32], cdf: &mut [f32]) -> f32 {
+    let mut sum = 0.0f32;
+    cdf[0] = 0.0;
+    for i in 0..x.len().saturating_sub(1) {
+        let (f0, f1) = (values[i], values[i + 1]);
+        let width = x[i + 1] - x[i];
+        let (d0, d1) = segment_derivatives(x, values, i);
+        sum += ((d0 - d1) * (1.0 / 12.0) + (f0 + f1) * 0.5) * width;
+        cdf[i + 1] = sum;
+    }
+    sum
+}
+
+/// pbrt-v3's `InvertCatmullRom`: the x where the spline through increasing `values` reaches
+/// `u` (clamped to the first or last node outside their range; NaN gives the first).
+pub fn invert_catmull_rom(x: &[f32], values: &[f32], u: f32) -> f32 {
+    let n = x.len();
+    use std::cmp::Ordering::{Greater, Less};
+    if u.partial_cmp(&values[0]) != Some(Greater) {
+        return x[0];
+    } else if u.partial_cmp(&values[n - 1]) != Some(Less) {
+        return x[n - 1];
+    }
+    let i = find_interval(n, |i| values[i] <= u);
+    let (x0, x1) = (x[i], x[i + 1]);
+    let (f0, f1) = (values[i], values[i + 1]);
+    let width = x1 - x0;
+    let (d0, d1) = segment_derivatives(x, values, i);
+    let (mut a, mut b, mut t) = (0.0f32, 1.0f32, 0.5f32);
+    // pbrt-v3 loops until convergence; bounded here so that a degenerate table cannot hang.
+    for _ in 0..100 {
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+        let (t2, t3) = (t * t, t * t * t);
+        let big_f = (2.0 * t3 - 3.0 * t2 + 1.0) * f0
+            + (-2.0 * t3 + 3.0 * t2) * f1
+            + (t3 - 2.0 * t2 + t) * d0
+            + (t3 - t2) * d1;
+        let f = (6.0 * t2 - 6.0 * t) * f0
+            + (-6.0 * t2 + 6.0 * t) * f1
+            + (3.0 * t2 - 4.0 * t + 1.0) * d0
+            + (3.0 * t2 - 2.0 * t) * d1;
+        if (big_f - u).abs() < 1e-6 || b - a < 1e-6 {
+            break;
+        }
+        if big_f - u < 0.0 {
+            a = t;
+        } else {
+            b = t;
+        }
+        t -= (big_f - u) / f;
+    }
+    x0 + t * width
+}
+
 /// pbrt-v3's `Fourier`: sum over k of `a[k] cos(k phi)`, in double precision.
 pub fn fourier(a: &[f32], cos_phi: f64) -> f32 {
     let mut value = 0.0f64;
@@ -229,5 +308,21 @@ mod tests {
             assert!((y - expect).abs() < 1e-4, "{u}");
             assert!((pdf - expect / (2.0 * std::f32::consts::PI)).abs() < 1e-4);
         }
+    }
+    #[test]
+    fn spline_integral_and_inverse_of_a_smooth_function() {
+        let x: Vec<f32> = (0..33).map(|i| i as f32 / 32.0).collect();
+        let v: Vec<f32> = x.iter().map(|&t| t * t).collect();
+        let mut cdf = vec![0.0; x.len()];
+        let total = integrate_catmull_rom(&x, &v, &mut cdf);
+        assert!((total - 1.0 / 3.0).abs() < 1e-3, "{total}");
+        assert!((cdf[16] - 0.5f32.powi(3) / 3.0).abs() < 1e-3, "{}", cdf[16]);
+        for u in [0.01f32, 0.2, 0.5, 0.81] {
+            let t = invert_catmull_rom(&x, &v, u);
+            assert!((t - u.sqrt()).abs() < 1e-3, "{u}: {t}");
+        }
+        assert_eq!(invert_catmull_rom(&x, &v, -1.0), 0.0);
+        assert_eq!(invert_catmull_rom(&x, &v, 2.0), 1.0);
+        assert_eq!(invert_catmull_rom(&x, &v, f32::NAN), 0.0);
     }
 }

@@ -4,6 +4,7 @@
 
 pub mod accel;
 pub mod bsdf;
+pub mod bssrdf;
 pub mod bump;
 pub mod camera;
 pub mod cli;

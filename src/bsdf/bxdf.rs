@@ -115,6 +115,15 @@ pub enum Bxdf {
     Disney(DisneyBxdf),
     /// pbrt-v3's tabulated `FourierBSDF` (the fourier material, `src/fourier.rs`).
     Fourier(FourierBsdf),
+    /// pbrt-v3's `SeparableBSSRDFAdapter`: where a subsurface path leaves the surface, the
+    /// BSSRDF's directional term `(1 - Fr(cos θi)) * scale` (scale = η² / (c π), made by
+    /// `src/bssrdf/adapter.rs`), diffuse reflection.
+    BssrdfAdapter {
+        /// Relative index of refraction, inside over outside.
+        eta: f32,
+        /// η² / (c π), with c = 1 - 2 FresnelMoment1(1 / η).
+        scale: f32,
+    },
 }
 
 impl Bxdf {
@@ -134,7 +143,9 @@ impl Bxdf {
     pub fn kind(&self) -> BxdfType {
         use BxdfType as T;
         match self {
-            Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } => T::REFLECTION.or(T::DIFFUSE),
+            Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } | Bxdf::BssrdfAdapter { .. } => {
+                T::REFLECTION.or(T::DIFFUSE)
+            }
             Bxdf::LambertianTransmission { .. } => T::TRANSMISSION.or(T::DIFFUSE),
             Bxdf::SpecularReflection { .. } => T::REFLECTION.or(T::SPECULAR),
             Bxdf::SpecularTransmission { .. } => T::TRANSMISSION.or(T::SPECULAR),
@@ -159,6 +170,9 @@ impl Bxdf {
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Spectrum {
         match *self {
             Bxdf::Lambertian { r } => r * FRAC_1_PI,
+            Bxdf::BssrdfAdapter { eta, scale } => {
+                Spectrum::splat((1.0 - fr_dielectric(cos_theta(wi), 1.0, eta)) * scale)
+            }
             // As pbrt-v3, whatever the sides: the BSDF's geometric test keeps transmission.
             Bxdf::LambertianTransmission { t } => t * FRAC_1_PI,
             Bxdf::OrenNayar { r, a, b } => {
@@ -253,7 +267,7 @@ impl Bxdf {
         use BxdfType as T;
         let kind = self.kind();
         let s = match *self {
-            Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } => {
+            Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } | Bxdf::BssrdfAdapter { .. } => {
                 let mut wi = cosine_sample_hemisphere(u);
                 if wo.z < 0.0 {
                     wi.z = -wi.z;
@@ -385,7 +399,7 @@ impl Bxdf {
     /// lobes).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let p = match *self {
-            Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } => {
+            Bxdf::Lambertian { .. } | Bxdf::OrenNayar { .. } | Bxdf::BssrdfAdapter { .. } => {
                 if same_hemisphere(wo, wi) {
                     abs_cos_theta(wi) * FRAC_1_PI
                 } else {

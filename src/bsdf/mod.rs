@@ -158,6 +158,7 @@ impl Bsdf {
                     Bxdf::Hair(h) => h.albedo(),
                     Bxdf::Disney(d) => d.albedo(),
                     Bxdf::Fourier(t) => t.table.albedo(),
+                    Bxdf::BssrdfAdapter { .. } => Spectrum::ONE,
                 };
                 nominal * l.scale
             })

@@ -4,16 +4,16 @@
 
 use super::{
     DisneyMaterial, Fourier, Glass, HairMaterial, Material, Matte, Metal, Mirror, Plastic,
-    Substrate, Translucent, Uber,
+    Substrate, Subsurface, Translucent, Uber,
 };
 use crate::geometry::Spectrum;
-use crate::texture::{Texture, TextureBuilder};
+use crate::texture::TextureBuilder;
 use acr_parser::{Error, MaterialDesc, ParamList, Result, SceneDescription, Warning};
 use std::path::Path;
 use std::sync::Arc;
 
 /// Material types acr builds.
-const KINDS: [&str; 12] = [
+const KINDS: [&str; 14] = [
     "matte",
     "translucent",
     "plastic",
@@ -26,9 +26,9 @@ const KINDS: [&str; 12] = [
     "disney",
     "mix",
     "fourier",
+    "subsurface",
+    "kdsubsurface",
 ];
-/// pbrt-v3 material types acr replaces by a matte.
-const UNSUPPORTED_KINDS: [&str; 2] = ["subsurface", "kdsubsurface"];
 /// Types that make no surface: rays pass through.
 const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
 /// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
@@ -102,6 +102,10 @@ impl<'a> MaterialBuilder<'a> {
             "hair" => Material::Hair(HairMaterial::from_params(t, p, loc)?),
             "fourier" => Material::Fourier(Fourier::from_params(t, p, loc)?),
             "disney" => Material::Disney(Box::new(DisneyMaterial::from_params(t, p, loc)?)),
+            "subsurface" => Material::Subsurface(Box::new(Subsurface::from_params(t, p, loc)?)),
+            "kdsubsurface" => {
+                Material::Subsurface(Box::new(Subsurface::kd_from_params(t, p, loc)?))
+            }
             "mix" => {
                 let amount = t.spectrum_param(p, "amount", Spectrum::splat(0.5))?;
                 let Some([a, b]) = md.mix else {
@@ -116,24 +120,13 @@ impl<'a> MaterialBuilder<'a> {
                 }
             }
             k if INTERFACE_KINDS.contains(&k) => Material::Interface,
-            k if UNSUPPORTED_KINDS.contains(&k) => {
-                t.warn_once(
-                    format!("material {k}"),
-                    loc,
-                    format!("material \"{k}\" is not supported; a matte with its Kd is used"),
-                );
-                Material::Matte(Matte {
-                    kd: t.spectrum_param(p, "Kd", Spectrum::splat(0.5))?,
-                    sigma: Texture::Constant(0.0),
-                })
-            }
             other => return Err(unknown_kind(other, loc)),
         })
     }
 }
 
 fn unknown_kind(kind: &str, loc: &acr_parser::Loc) -> Error {
-    let hint = acr_parser::closest(kind, KINDS.iter().chain(&UNSUPPORTED_KINDS).copied())
+    let hint = acr_parser::closest(kind, KINDS.iter().copied())
         .map_or(String::new(), |k| format!(" (did you mean \"{k}\"?)"));
     Error::at(loc, format!("unknown material \"{kind}\"{hint}"))
 }
@@ -174,7 +167,7 @@ pub fn build_materials(
 ) -> Result<Vec<Material>> {
     for md in &desc.materials {
         let k = md.plugin.kind.as_str();
-        if !(KINDS.contains(&k) || UNSUPPORTED_KINDS.contains(&k) || INTERFACE_KINDS.contains(&k)) {
+        if !(KINDS.contains(&k) || INTERFACE_KINDS.contains(&k)) {
             return Err(unknown_kind(k, &md.plugin.loc));
         }
     }

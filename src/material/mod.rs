@@ -1,14 +1,13 @@
 //! pbrt-v3's materials (materials/*.cpp), one type per material, each in its own file: matte,
-//! plastic, mirror, glass, metal, uber, substrate, translucent, hair, disney and fourier, with
+//! plastic, mirror, glass, metal, uber, substrate, translucent, hair, disney, fourier, and
+//! subsurface and kdsubsurface (whose [`Material::bssrdf`] the path integrator samples), with
 //! textured parameters, each turning a hit into a [`Bsdf`]'s lobes as pbrt-v3's
 //! `ComputeScatteringFunctions` does (radiance transport, several lobes allowed as the path
 //! integrator asks). [`Material`] is the enum a hit dispatches on; mix and bump mapping wrap
 //! other materials and live here.
 //!
 //! Bump mapping (`bumpmap` on every material) is [`crate::bump`]'s. Not supported: per-shape
-//! overrides of material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like), and the
-//! subsurface and kdsubsurface materials (replaced by a matte with the material's `Kd`, with a
-//! warning).
+//! overrides of material parameters (pbrt-v3 lets a `Shape` carry `Kd` and the like).
 
 use crate::bsdf::Bsdf;
 use crate::geometry::{Spectrum, SurfaceInteraction};
@@ -26,6 +25,7 @@ pub mod mirror;
 pub mod plastic;
 mod shared;
 pub mod substrate;
+pub mod subsurface;
 pub mod translucent;
 pub mod uber;
 
@@ -39,6 +39,7 @@ pub use metal::{Metal, COPPER_ETA, COPPER_K};
 pub use mirror::Mirror;
 pub use plastic::Plastic;
 pub use substrate::Substrate;
+pub use subsurface::Subsurface;
 pub use translucent::Translucent;
 pub use uber::Uber;
 
@@ -70,6 +71,9 @@ pub enum Material {
     Fourier(Fourier),
     /// pbrt-v3's `disney`.
     Disney(Box<DisneyMaterial>),
+    /// pbrt-v3's `subsurface` or `kdsubsurface`: a dielectric boundary over a scattering
+    /// medium (docs/subsurface.md).
+    Subsurface(Box<Subsurface>),
     /// pbrt-v3's mix: the lobes of `materials[0]` weighted by `amount`, those of `materials[1]`
     /// by 1 - amount.
     Mix {
@@ -115,6 +119,17 @@ impl Material {
         }
     }
 
+    /// The BSSRDF at (shaded) hit `si`, for a subsurface material (bumped or not); `None`
+    /// otherwise. A mix gives none: pbrt-v3's mix leaves its first material's BSSRDF, whose
+    /// probe rays then look for that material and never find the mix, so its paths end.
+    pub fn bssrdf(&self, si: &SurfaceInteraction) -> Option<crate::bssrdf::TabulatedBssrdf<'_>> {
+        match self {
+            Material::Subsurface(m) => Some(m.bssrdf(si)),
+            Material::Bumped { inner, .. } => inner.bssrdf(si),
+            _ => None,
+        }
+    }
+
     /// The BSDF at a hit (several lobes allowed, as pbrt-v3's path integrators ask: a smooth
     /// glass is one `FresnelSpecular` lobe).
     pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
@@ -156,6 +171,7 @@ impl Material {
             Material::Hair(m) => m.add_lobes(si, b, scale, first),
             Material::Disney(m) => m.add_lobes(si, b, scale),
             Material::Fourier(m) => m.add_lobes(b, scale),
+            Material::Subsurface(m) => m.add_lobes(si, allow_multiple_lobes, b, scale, first),
             Material::Mix { amount, materials } => {
                 let s1 = shared::clamp0(amount.eval(si));
                 let s2 = shared::clamp0(Spectrum::ONE - s1);

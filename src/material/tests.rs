@@ -296,11 +296,6 @@ fn unsupported_parameters_warn_once_and_unknown_types_fail() {
     assert!(e.message().contains("plastic"), "{e}");
     assert!(matches!(e, Error::At { .. }));
 
-    let (m, w) = build(&format!(
-        "Material \"subsurface\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
-    ));
-    assert_eq!(w.len(), 1);
-    assert!(matches!(m.last().unwrap(), Material::Matte(_)));
     // fourier reads its table (docs/pbrt-v3-compatibility.md): without one, a located error.
     let e = build_err(&format!(
         "Material \"fourier\" \"rgb Kd\" [0.2 0.2 0.2]\n{SHAPE}"
@@ -383,4 +378,76 @@ fn images_shared_by_materials_are_read_once() {
     }
     assert_eq!(b.textures.files_read(), 1);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// subsurface and kdsubsurface (docs/subsurface.md): pbrt-v3's parameters, a BSSRDF at each
+/// hit, warnings and located errors for bad input.
+#[test]
+fn subsurface_materials_build_with_pbrt_v3_parameters() {
+    let (m, w) = build(&format!(
+        "Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" [2] \"float g\" [0.5]\n{SHAPE}"
+    ));
+    assert!(w.is_empty(), "{w:?}");
+    let b = m.last().unwrap().bssrdf(&si()).unwrap();
+    // Skin1's coefficients times the scale; g forced to 0 by the name (its table is g = 0's).
+    let (a, s) = crate::bssrdf::measured::lookup("Skin1").unwrap();
+    assert!(
+        (b.sigma_t - 2.0 * (a + s)).abs().max_element() < 1e-6,
+        "{}",
+        b.sigma_t
+    );
+    assert!(std::ptr::eq(b.table, &*crate::bssrdf::table_for(0.0, 1.33)));
+    // The boundary: one FresnelSpecular, index 1.33.
+    let bsdf = m.last().unwrap().bsdf(&si());
+    assert_eq!((bsdf.num_lobes(), bsdf.eta()), (1, 1.33));
+    // Defaults: pbrt-v3's whole milk.
+    let (m, _) = build(&format!("Material \"subsurface\"\n{SHAPE}"));
+    let b = m.last().unwrap().bssrdf(&si()).unwrap();
+    assert!((b.sigma_t.x - (0.0011 + 2.55)).abs() < 1e-5);
+    // kdsubsurface: Kd inverted through the table, mfp 1.
+    let (m, w) = build(&format!(
+        "Material \"kdsubsurface\" \"rgb Kd\" [0.2 0.5 0.9] \"rgb mfp\" [1 0.5 2]\n{SHAPE}"
+    ));
+    assert!(w.is_empty(), "{w:?}");
+    let b = m.last().unwrap().bssrdf(&si()).unwrap();
+    assert!(
+        (b.sigma_t - Spectrum::new(1.0, 2.0, 0.5))
+            .abs()
+            .max_element()
+            < 1e-4
+    );
+    // A bumped subsurface keeps its BSSRDF; other materials have none.
+    let (m, _) = build(&format!(
+        "Texture \"bump\" \"float\" \"constant\"\nMaterial \"kdsubsurface\" \"texture bumpmap\" \"bump\"\n{SHAPE}\nMaterial \"matte\"\n{SHAPE}"
+    ));
+    assert!(m[m.len() - 2].bssrdf(&si()).is_some());
+    assert!(m.last().unwrap().bssrdf(&si()).is_none());
+
+    // An unknown name: pbrt-v3's warning (located, with a hint), its defaults used.
+    let (m, w) = build(&format!(
+        "Material \"subsurface\" \"string name\" \"Ketchp\"\n{SHAPE}"
+    ));
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].message.contains("Ketchup") && w[0].loc.is_some(),
+        "{w:?}"
+    );
+    assert!(m.last().unwrap().bssrdf(&si()).is_some());
+    // Negative coefficients: a located warning, clamped as pbrt-v3 clamps them.
+    let (m, w) = build(&format!(
+        "Material \"subsurface\" \"rgb sigma_a\" [-1 0.1 0.1]\n{SHAPE}"
+    ));
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].message.contains("sigma_a") && w[0].loc.is_some());
+    let b = m.last().unwrap().bssrdf(&si()).unwrap();
+    assert!(b.sigma_t.x >= 0.0 && b.sigma_t.is_finite());
+    // Parameters the table cannot take: located errors.
+    for bad in [
+        "\"float eta\" [0.9]",
+        "\"float g\" [1]",
+        "\"float scale\" [-2]",
+    ] {
+        let e = build_err(&format!("Material \"kdsubsurface\" {bad}\n{SHAPE}"));
+        assert!(matches!(e, Error::At { .. }), "{bad}: {e}");
+    }
 }

@@ -1,0 +1,100 @@
+//! The path integrator's subsurface step (pbrt-v3's `PathIntegrator::Li`, its BSSRDF block;
+//! docs/subsurface.md): when a path is transmitted into a subsurface material, an exit point is
+//! found by a probe segment around the entry point (pbrt-v3's `Sample_Sp`: every surface of
+//! the same material along it, one chosen uniformly), the throughput takes Sp / pdf, light is
+//! sampled at the exit point through the adapter BSDF, and the path continues from there by a
+//! sample of that BSDF. Kept apart from `path` so that `volpath` can call it too.
+
+use super::{next_event, LastScatter, MAX_PASS_THROUGH};
+use crate::bssrdf::{adapter_bsdf, TabulatedBssrdf};
+use crate::geometry::{is_valid_radiance, Ray, Spectrum, SurfaceInteraction};
+use crate::lightbvh::LightContext;
+use crate::lightdistrib::LightStrategy;
+use crate::scene::Scene;
+use crate::stream::SampleStream;
+
+/// Follows a path that entered material `material` (whose BSSRDF at the entry point is
+/// `bssrdf`, at time `time`) to its exit point: multiplies `beta` by Sp / pdf, adds the light
+/// sampled there to `l`, multiplies `beta` by the adapter BSDF's sample and records that
+/// scattering in `last` (for the MIS weight of the emission the next ray finds). Returns the
+/// ray that continues the path; `None` ends it (no exit point found, nothing to sample), as
+/// pbrt-v3's `break`. Every probe and shadow ray is counted in `rays`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn scatter(
+    scene: &Scene,
+    bssrdf: &TabulatedBssrdf,
+    material: u32,
+    time: f32,
+    strategy: LightStrategy,
+    stream: &mut SampleStream,
+    beta: &mut Spectrum,
+    l: &mut Spectrum,
+    last: &mut LastScatter,
+    rays: &mut u32,
+) -> Option<Ray> {
+    let u1 = stream.next_1d();
+    let u2 = stream.next_2d();
+    let probe = bssrdf.probe(u1, u2)?;
+    // Every surface of the same material along the segment (pbrt-v3 compares material
+    // pointers; acr's materials are indices). Other surfaces are crossed.
+    let mut found: Vec<SurfaceInteraction> = Vec::new();
+    let mut ray = Ray::new(probe.start, probe.end - probe.start, time);
+    let mut t_max = 1.0 - crate::geometry::SHADOW_EPSILON;
+    for _ in 0..MAX_PASS_THROUGH {
+        if ray.d == crate::geometry::Vec3::ZERO {
+            break;
+        }
+        *rays += 1;
+        let Some(hit) = scene.accel.intersect(&ray, t_max) else {
+            break;
+        };
+        let si = scene.accel.interaction(&ray, &hit);
+        (ray, t_max) = si.spawn_ray_to(probe.end);
+        if scene.surfaces[hit.prim.surface as usize].material == Some(material) {
+            found.push(si);
+        }
+    }
+    if found.is_empty() {
+        return None;
+    }
+    let n = found.len();
+    let chosen = ((probe.u_choice * n as f32) as usize).min(n - 1);
+    let mut pi = found[chosen];
+    let pdf = bssrdf.pdf_sp(pi.p, pi.n) / n as f32;
+    let sp = bssrdf.sp(pi.p);
+    if sp == Spectrum::ZERO || pdf.is_nan() || pdf <= 0.0 {
+        return None;
+    }
+    *beta *= sp / pdf;
+    if !is_valid_radiance(*beta) {
+        return None;
+    }
+    // pbrt-v3's `Sample_S`: the exit point looks out along its shading normal.
+    pi.wo = pi.shading_n;
+    let bsdf = adapter_bsdf(&pi, bssrdf.eta);
+    last.ctx = None;
+    if !scene.lights.is_empty() {
+        let ctx = LightContext {
+            p: pi.p,
+            n: pi.shading_n,
+        };
+        last.ctx = Some(ctx);
+        if let Some(direct) = next_event(scene, &pi, &bsdf, ctx, strategy, stream, rays) {
+            *l += *beta * direct;
+        }
+    }
+    let u_lobe = stream.next_1d();
+    let u = stream.next_2d();
+    let s = bsdf.sample_f(pi.wo, u, u_lobe)?;
+    if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
+        return None;
+    }
+    *beta *= s.f * s.wi.dot(pi.shading_n).abs() / s.pdf;
+    if !is_valid_radiance(*beta) {
+        return None;
+    }
+    last.whole = false;
+    last.p = pi.p;
+    last.bsdf_pdf = s.pdf;
+    Some(pi.spawn_ray(s.wi))
+}
