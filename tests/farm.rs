@@ -294,13 +294,15 @@ fn nfor_writes_the_box_filters_sums_and_aovs_from_its_halves() {
     let (mv, bv) = (nsums.variance().unwrap(), bsums.variance().unwrap());
     let worst = worst_relative(&mv, &bv);
     assert!(worst < 1e-4, "moments {worst}");
-    // Ranges 0..4 and 4..8 merge into the 8-spp file.
+    // Ranges 0..4 and 4..8, each with the whole render's texture footprint, merge into the
+    // 8-spp file.
     let (a, b, m) = (path("a"), path("b"), path("m"));
-    render("nfor", &a, &["--spp", "4", "--mergeable"]);
+    let range = ["--spp", "4", "--footprint-spp", "8", "--mergeable"];
+    render("nfor", &a, &range);
     render(
         "nfor",
         &b,
-        &["--spp", "4", "--sample-offset", "4", "--mergeable"],
+        &[&range[..], &["--sample-offset", "4"]].concat(),
     );
     ok(&["merge", s(&m), s(&a), s(&b)]);
     let merged = Sums::read(&m).unwrap().unwrap();
