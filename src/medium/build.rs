@@ -99,7 +99,7 @@ fn build_medium(
     }
     let (sigma_a, sigma_s) = coefficients(m, warnings)?;
     let g = params.float_or("g", 0.0)? as f32;
-    if !(g.abs() < 1.0) {
+    if g.is_nan() || g.abs() >= 1.0 {
         return Err(Error::at(
             loc_of(params, "g", loc),
             format!(
