@@ -6,6 +6,7 @@
 //! (`MediumInterface`) puts on the side the ray leaves by. See docs/media.md.
 
 use super::{Radiance, MAX_PASS_THROUGH};
+use crate::accel::Hit;
 use crate::bsdf::Bsdf;
 use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3, SHADOW_EPSILON};
@@ -13,7 +14,7 @@ use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::medium::{HenyeyGreenstein, MediumInterface};
 use crate::sampling::power_heuristic;
-use crate::scene::{Scene, SceneHit};
+use crate::scene::{Scene, SceneHit, Surface};
 use crate::stream::SampleStream;
 
 /// `volpath`'s settings.
@@ -163,25 +164,40 @@ impl Vertex<'_> {
 /// The surface's media as seen by a ray in `medium`: its own where it is a transition, else
 /// `medium` on both sides (pbrt-v3's `GeometricPrimitive::Intersect`).
 #[inline]
-fn media_at(hit: &SceneHit, medium: Option<u32>) -> MediumInterface {
-    hit.surface.media.unwrap_or(MediumInterface {
+fn media_at(surface: &Surface, medium: Option<u32>) -> MediumInterface {
+    surface.media.unwrap_or(MediumInterface {
         inside: medium,
         outside: medium,
     })
 }
 
-/// The closest hit along `ray` before parameter `t_max`, and its parameter.
-#[inline]
-fn intersect(scene: &Scene, ray: &Ray, t_max: f32) -> Option<(SceneHit, f32)> {
-    let hit = scene.accel.intersect(ray, t_max)?;
-    let si = scene.accel.interaction(ray, &hit);
-    Some((
+/// A ray's closest hit before its interaction is computed (which a path that scatters in a
+/// medium first, or a shadow ray that is blocked, never needs).
+#[derive(Clone, Copy)]
+struct RawHit {
+    hit: Hit,
+    surface: Surface,
+}
+
+impl RawHit {
+    /// The hit, resolved for `ray` (the ray that found it).
+    #[inline]
+    fn resolve(&self, scene: &Scene, ray: &Ray) -> SceneHit {
         SceneHit {
-            si,
-            surface: scene.surfaces[hit.prim.surface as usize],
-        },
-        hit.t,
-    ))
+            si: scene.accel.interaction(ray, &self.hit),
+            surface: self.surface,
+        }
+    }
+}
+
+/// The closest hit along `ray` before parameter `t_max`.
+#[inline]
+fn intersect(scene: &Scene, ray: &Ray, t_max: f32) -> Option<RawHit> {
+    let hit = scene.accel.intersect(ray, t_max)?;
+    Some(RawHit {
+        hit,
+        surface: scene.surfaces[hit.prim.surface as usize],
+    })
 }
 
 /// Transmittance through `medium` along `ray` up to `t_max`.
@@ -213,22 +229,21 @@ fn transmittance_to(
     for _ in 0..MAX_PASS_THROUGH {
         *rays += 1;
         let hit = intersect(scene, &mr.ray, t_max);
-        if let Some((h, _)) = &hit {
-            if h.surface.material.is_some() {
-                return Spectrum::ZERO;
-            }
+        if hit.is_some_and(|h| h.surface.material.is_some()) {
+            return Spectrum::ZERO;
         }
-        let t_end = hit.as_ref().map_or(t_max, |(_, t)| *t);
+        let t_end = hit.map_or(t_max, |h| h.hit.t);
         tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
-        let Some((h, _)) = hit else {
+        let Some(h) = hit else {
             return tr;
         };
         if tr == Spectrum::ZERO {
             return tr;
         }
-        let (ray, t) = h.si.spawn_ray_to(target);
+        let si = scene.accel.interaction(&mr.ray, &h.hit);
+        let (ray, t) = si.spawn_ray_to(target);
         mr = MediumRay {
-            medium: media_at(&h, mr.medium).toward(h.si.n, ray.d),
+            medium: media_at(&h.surface, mr.medium).toward(si.n, ray.d),
             ray,
         };
         t_max = t;
@@ -237,29 +252,31 @@ fn transmittance_to(
 }
 
 /// pbrt-v3's `Scene::IntersectTr`: the first surface with a material along `mr`, crossing
-/// interfaces, and the transmittance up to it (or to infinity when none is found).
+/// interfaces (with the ray that found it), and the transmittance up to it (or to infinity
+/// when none is found).
 fn intersect_tr(
     scene: &Scene,
     mut mr: MediumRay,
     stream: &mut SampleStream,
     rays: &mut u32,
-) -> (Option<SceneHit>, Spectrum) {
+) -> (Option<(RawHit, Ray)>, Spectrum) {
     let mut tr = Spectrum::ONE;
     for _ in 0..MAX_PASS_THROUGH {
         *rays += 1;
         let hit = intersect(scene, &mr.ray, f32::INFINITY);
-        let t_end = hit.as_ref().map_or(f32::INFINITY, |(_, t)| *t);
+        let t_end = hit.map_or(f32::INFINITY, |h| h.hit.t);
         tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
-        let Some((h, _)) = hit else {
+        let Some(h) = hit else {
             return (None, tr);
         };
         if h.surface.material.is_some() {
-            return (Some(h), tr);
+            return (Some((h, mr.ray)), tr);
         }
+        let si = scene.accel.interaction(&mr.ray, &h.hit);
         let d = mr.ray.d;
         mr = MediumRay {
-            medium: media_at(&h, mr.medium).toward(h.si.n, d),
-            ray: h.si.spawn_ray(d),
+            medium: media_at(&h.surface, mr.medium).toward(si.n, d),
+            ray: si.spawn_ray(d),
         };
     }
     (None, Spectrum::ZERO)
@@ -304,10 +321,13 @@ fn estimate_direct(
     }
     let (hit, tr) = intersect_tr(scene, v.spawn(s.wi), stream, rays);
     let (li, light_pdf) = match hit {
-        Some(h) if h.surface.area_light == Some(light_index as u32) => (
-            light.l(&h.si, -s.wi),
-            light.pdf_area_hit(&scene.accel.world, p, h.si.p, h.si.n),
-        ),
+        Some((h, ray)) if h.surface.area_light == Some(light_index as u32) => {
+            let si = scene.accel.interaction(&ray, &h.hit);
+            (
+                light.l(&si, -s.wi),
+                light.pdf_area_hit(&scene.accel.world, p, si.p, si.n),
+            )
+        }
         Some(_) => return ld,
         None => (light.le(s.wi), light.pdf_le(s.wi)),
     };
@@ -374,7 +394,7 @@ pub(super) fn volpath_li(
     loop {
         rays += 1;
         let hit = intersect(scene, &mr.ray, f32::INFINITY);
-        let t_hit = hit.as_ref().map_or(f32::INFINITY, |(_, t)| *t);
+        let t_hit = hit.map_or(f32::INFINITY, |h| h.hit.t);
         let mut scatter_t = None;
         if let Some(m) = mr.medium {
             let medium = &scene.media[m as usize];
@@ -408,7 +428,7 @@ pub(super) fn volpath_li(
             mr = v.spawn(s.wi);
             specular_bounce = false;
         } else {
-            let hit = hit.map(|(h, _)| h);
+            let hit = hit.map(|h| h.resolve(scene, &mr.ray));
             if bounces == 0 || specular_bounce {
                 l += beta * emission(scene, hit.as_ref(), mr.ray.d);
             }
@@ -423,7 +443,7 @@ pub(super) fn volpath_li(
                 si.compute_differentials(d);
             }
             probe.travel(mr.ray.o, si.p);
-            let media = media_at(&hit, mr.medium);
+            let media = media_at(&hit.surface, mr.medium);
             let Some(material) = hit.surface.material else {
                 // An interface: the ray goes on in the same direction (not a bounce).
                 pass_through += 1;
