@@ -184,7 +184,7 @@ mod tests {
         assert_eq!(g.density_at(Vec3::new(0.75, 0.75, 0.75)), 7.0);
         assert!((g.density_at(Vec3::new(0.5, 0.5, 0.5)) - 3.5).abs() < 1e-6);
         // Half a voxel beyond the centres the grid fades towards zero outside.
-        assert!((g.density_at(Vec3::new(1.0, 0.75, 0.75)) - 2.0).abs() < 1e-6);
+        assert!((g.density_at(Vec3::new(1.0, 0.75, 0.75)) - 3.5).abs() < 1e-6);
     }
 
     /// Ratio tracking and delta tracking agree with the transmittance of a constant grid
@@ -227,6 +227,42 @@ mod tests {
         assert!(
             (delta - f64::from(expected)).abs() < 0.005,
             "{delta} {expected}"
+        );
+        // A grid of two halves, density 0.1 and 3, crossed along x: both estimators give
+        // exp(-sigma_t * (0.1 + 3) * half length) against the grid's majorant.
+        let mut two = vec![0.1f32; 64 * 64 * 4];
+        for z in 0..4 {
+            for y in 0..64 {
+                for x in 32..64 {
+                    two[(z * 64 + y) * 64 + x] = 3.0;
+                }
+            }
+        }
+        let g2 = Grid::new(
+            Spectrum::splat(0.5),
+            0.6,
+            [64, 64, 4],
+            two,
+            render_from_grid,
+        );
+        let half = 1.5f32;
+        let expected2 = (-0.6f32 * (0.1 + 3.0) * half).exp();
+        let (o2, d2) = (Vec3::new(-1.5, 0.1, 0.0), Vec3::new(3.0, 0.0, 0.0));
+        let (mut ratio2, mut passed2) = (0.0f64, 0usize);
+        for _ in 0..runs {
+            ratio2 += f64::from(g2.tr(o2, d2, 1.0, &mut u).x);
+            if g2.sample(o2, d2, 1.0, &mut u).t.is_none() {
+                passed2 += 1;
+            }
+        }
+        let (ratio2, delta2) = (ratio2 / runs as f64, passed2 as f64 / runs as f64);
+        assert!(
+            (ratio2 - f64::from(expected2)).abs() < 0.004,
+            "{ratio2} {expected2}"
+        );
+        assert!(
+            (delta2 - f64::from(expected2)).abs() < 0.004,
+            "{delta2} {expected2}"
         );
         // A ray that misses the box passes whole.
         let far = Vec3::new(0.0, 5.0, 0.0);

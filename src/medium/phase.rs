@@ -68,7 +68,7 @@ mod tests {
         for g in [-0.7f32, 0.0, 0.3, 0.9] {
             let hg = HenyeyGreenstein { g };
             let wo = Vec3::new(0.0, 0.0, 1.0);
-            let n = 400;
+            let n = 20_000;
             let (mut total, mut mean) = (0.0f64, 0.0f64);
             for i in 0..n {
                 let cos = -1.0 + 2.0 * (i as f32 + 0.5) / n as f32;
