@@ -4,7 +4,6 @@
 
 use super::{Grid, HenyeyGreenstein, Homogeneous, Medium, MediumKind};
 use crate::geometry::Spectrum;
-use crate::scene::rgb_param;
 use acr_parser::{Error, Loc, MediumDesc, ParamList, ParamType, Result, Warning};
 use glam::{DMat4, DVec3};
 
@@ -57,7 +56,7 @@ fn coefficients(m: &MediumDesc, warnings: &mut Vec<Warning>) -> Result<(Spectrum
         .into_iter()
         .enumerate()
     {
-        let v = rgb_param(params, name, default)? * scale;
+        let v = crate::texture::spectrum_value(params, name)?.unwrap_or(default) * scale;
         if !g_ok(v) {
             let at = if params.get(name).is_some() {
                 loc_of(params, name, loc)
