@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes scenes/pbrt-v3/media/cloud-density.pbrt: a 16^3 density grid (a lumpy blob, values
+"""Writes scenes/pbrt-v3/geometry/cloud-density.pbrt: a 16^3 density grid (a lumpy blob, values
 in [0, 1] with three decimals) included by scenes/pbrt-v3/media-cloud.pbrt. Deterministic."""
 import math
 import sys
@@ -14,7 +14,7 @@ for z in range(N):
             lumps = 0.5 + 0.5 * math.sin(9 * p[0] + 2) * math.sin(11 * p[1] + 1) * math.sin(7 * p[2])
             d = max(0.0, 1 - r / 0.48) * (0.55 + 0.45 * lumps)
             values.append(round(min(1.0, 1.6 * d), 3))
-out = sys.argv[1] if len(sys.argv) > 1 else "scenes/pbrt-v3/media/cloud-density.pbrt"
+out = sys.argv[1] if len(sys.argv) > 1 else "scenes/pbrt-v3/geometry/cloud-density.pbrt"
 with open(out, "w") as f:
     f.write("# A 16^3 density grid made by tests/data/media/make-cloud.py. CC0.\n")
     f.write('MakeNamedMedium "cloud" "string type" "heterogeneous"\n')
