@@ -135,6 +135,7 @@ pub fn render(data: &[u8]) {
         Integrator::Path { max_depth, .. } | Integrator::Direct { max_depth, .. } => {
             *max_depth = (*max_depth).min(8);
         }
+        Integrator::VolPath(settings) => settings.max_depth = settings.max_depth.min(8),
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

@@ -64,6 +64,20 @@ impl FirstHitProbe {
         });
     }
 
+    /// The path scatters in a medium of single-scattering albedo `albedo` at the end of the
+    /// last travel: the features are that albedo, a zero normal (a medium has no surface) and
+    /// the distance (docs/media.md).
+    #[inline]
+    pub fn medium(&mut self, albedo: Spectrum) {
+        if self.hit.is_none() {
+            self.hit = Some(FirstHit {
+                albedo,
+                normal: Vec3::ZERO,
+                depth: self.travelled,
+            });
+        }
+    }
+
     /// The features (zeros when none were found).
     pub fn features(&self) -> FirstHit {
         self.hit.unwrap_or_default()

@@ -20,6 +20,8 @@ use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
 mod subsurface;
+mod volpath;
+pub use volpath::VolPathSettings;
 
 /// Most consecutive pass-through surfaces (`Material ""`) a ray may cross before it is
 /// abandoned: a guard against a ray trapped between coincident interfaces.
@@ -46,6 +48,8 @@ pub enum Integrator {
         /// How a light is chosen for next-event estimation.
         light_strategy: LightStrategy,
     },
+    /// `volpath`: path tracing through participating media (docs/media.md).
+    VolPath(VolPathSettings),
     /// `directlighting`.
     Direct {
         /// Specular recursion depth.
@@ -102,6 +106,34 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
     Entry {
         info: PluginInfo {
             kind: Kind::Integrator,
+            name: "volpath",
+            doc: "path tracing through participating media: medium and phase sampling, MIS with lights through media (pbrt-v3 volpath)",
+            params: &[
+                ParamSpec::new(
+                    "maxdepth",
+                    ParamType::Integer,
+                    "5",
+                    "longest path, in scattering events (surface or medium)",
+                ),
+                ParamSpec::new(
+                    "rrthreshold",
+                    ParamType::Float,
+                    "1",
+                    "Russian roulette once the throughput's largest channel is below this",
+                ),
+                ParamSpec::new(
+                    "lightsamplestrategy",
+                    ParamType::String,
+                    "bvh",
+                    "how a light is chosen: bvh (pbrt-v4's light BVH), spatial (pbrt-v3's default), power or uniform",
+                ),
+            ],
+        },
+        build: Integrator::volpath,
+    },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
             name: "directlighting",
             doc: "direct lighting plus specular reflection and refraction (pbrt-v3 directlighting)",
             params: &[
@@ -132,25 +164,40 @@ fn max_depth(params: &ParamList) -> Result<u32> {
     })
 }
 
+/// `path`'s and `volpath`'s parameters (pbrt-v3's defaults: maxdepth 5, rrthreshold 1).
+fn path_settings(c: &Choice) -> Result<VolPathSettings> {
+    let params = &c.params;
+    let name = params.string("lightsamplestrategy")?.unwrap_or("bvh");
+    let Some(light_strategy) = LightStrategy::from_name(name) else {
+        let p = params.get("lightsamplestrategy");
+        let message =
+            format!("lightsamplestrategy \"{name}\" is not bvh, spatial, power or uniform");
+        return Err(match p {
+            Some(p) => Error::at(&p.loc, message),
+            None => Error::file("lightsamplestrategy", message),
+        });
+    };
+    Ok(VolPathSettings {
+        max_depth: max_depth(params)?,
+        rr_threshold: params.float_or("rrthreshold", 1.0)? as f32,
+        light_strategy,
+    })
+}
+
 impl Integrator {
     /// `path` from its parameters (pbrt-v3's defaults: maxdepth 5, rrthreshold 1).
     pub fn path(c: &Choice) -> Result<Self> {
-        let params = &c.params;
-        let name = params.string("lightsamplestrategy")?.unwrap_or("bvh");
-        let Some(light_strategy) = LightStrategy::from_name(name) else {
-            let p = params.get("lightsamplestrategy");
-            let message =
-                format!("lightsamplestrategy \"{name}\" is not bvh, spatial, power or uniform");
-            return Err(match p {
-                Some(p) => Error::at(&p.loc, message),
-                None => Error::file("lightsamplestrategy", message),
-            });
-        };
+        let s = path_settings(c)?;
         Ok(Integrator::Path {
-            max_depth: max_depth(params)?,
-            rr_threshold: params.float_or("rrthreshold", 1.0)? as f32,
-            light_strategy,
+            max_depth: s.max_depth,
+            rr_threshold: s.rr_threshold,
+            light_strategy: s.light_strategy,
         })
+    }
+
+    /// `volpath` from its parameters (those of `path`, the same defaults).
+    pub fn volpath(c: &Choice) -> Result<Self> {
+        Ok(Integrator::VolPath(path_settings(c)?))
     }
 
     /// `directlighting` from its parameters (pbrt-v3's defaults: maxdepth 5, strategy all).
@@ -177,6 +224,7 @@ impl Integrator {
     pub fn name(&self) -> &'static str {
         match self {
             Integrator::Path { .. } => "path",
+            Integrator::VolPath(_) => "volpath",
             Integrator::Direct { .. } => "directlighting",
         }
     }
@@ -204,6 +252,9 @@ impl Integrator {
                 rr_threshold,
                 light_strategy,
             ),
+            Integrator::VolPath(settings) => {
+                volpath::volpath_li(scene, ray, diff, stream, settings)
+            }
             Integrator::Direct {
                 max_depth,
                 strategy,

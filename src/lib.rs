@@ -20,6 +20,7 @@ pub mod light;
 pub mod lightbvh;
 pub mod lightdistrib;
 pub mod material;
+pub mod medium;
 pub mod metrics;
 pub mod microfacet;
 pub mod mipmap;

@@ -118,6 +118,23 @@ fn resolve<'a, B>(
     Ok(entry)
 }
 
+/// pbrt-v3's warning for a scene with media rendered by an integrator that ignores them.
+fn media_warning(desc: &SceneDescription, integrator: &Integrator, warnings: &mut Vec<Warning>) {
+    if desc.media.is_empty() || matches!(integrator, Integrator::VolPath(_)) {
+        return;
+    }
+    let message = format!(
+        "the scene has participating media but the \"{}\" integrator ignores them (as \
+         pbrt-v3's does); use \"volpath\"",
+        integrator.name()
+    );
+    let loc = desc
+        .integrator
+        .as_ref()
+        .map_or(&desc.media[0].plugin.loc, |i| &i.loc);
+    warnings.push(Warning::at(loc, message));
+}
+
 /// Chooses and builds the sampler, filter and integrator: the scene's directives, with the
 /// command line's names and settings on top. Without a directive, pbrt-v3's defaults: the
 /// `halton` sampler at 16 spp, the `box` filter and the `path` integrator. The sampler's
@@ -136,6 +153,7 @@ pub fn choose(
     let ie: &Entry<IntegratorBuild> =
         resolve(INTEGRATORS, Kind::Integrator, &mut ic, overrides, warnings)?;
     let integrator = (ie.build)(&ic)?;
+    media_warning(desc, &integrator, warnings);
 
     let mut fc = Choice::new(desc.filter.as_ref(), "box", overrides.filter.as_deref());
     let fe: &Entry<FilterBuild> = resolve(FILTERS, Kind::Filter, &mut fc, overrides, warnings)?;

@@ -43,7 +43,7 @@ const KEPT: &[(&str, Check, usize)] = &[
     ("parse", cases::parse, 0),
     ("ply", cases::ply, 0),
     ("scene", cases::scene, 1),
-    ("render", cases::render, 1),
+    ("render", cases::render, 2),
     ("fourier", cases::fourier, 1),
     ("merge", cases::merge, 2),
 ];

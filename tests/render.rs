@@ -378,6 +378,9 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("environment-map.pbrt", "environment-map", 16),
     ("subsurface.pbrt", "subsurface", 16),
     ("kdsubsurface.pbrt", "kdsubsurface", 16),
+    ("media-homogeneous.pbrt", "media-homogeneous", 16),
+    ("media-cloud.pbrt", "media-cloud", 16),
+    ("media-fog-spot.pbrt", "media-fog-spot", 16),
 ];
 
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's

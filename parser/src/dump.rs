@@ -1,7 +1,7 @@
 //! The scene graph as stable, readable text: what `acr parse` prints and snapshots compare.
 
 use crate::fmt_num;
-use crate::scene::{PluginDesc, SceneDescription, ShapeDesc};
+use crate::scene::{MediumInterfaceDesc, PluginDesc, SceneDescription, ShapeDesc};
 use crate::source::Loc;
 use crate::transform::AnimatedTransform;
 use glam::DMat4;
@@ -126,7 +126,24 @@ impl SceneDescription {
                 2,
                 format!("world_from_light: {}", matrix(&l.world_from_light)),
             );
+            media_line(o, 2, &l.media);
             d.params(o, 2, &l.plugin);
+        }
+        // Media only where the scene has them, so that other scenes' dumps stay as they were.
+        if !self.media.is_empty() {
+            wl(o, 0, format!("media: {}", self.media.len()));
+            for (i, m) in self.media.iter().enumerate() {
+                d.plugin(o, 1, &format!("#{i} \"{}\"", m.name), &m.plugin);
+                if !m.world_from_medium.abs_diff_eq(DMat4::IDENTITY, DUST) {
+                    let t = matrix(&m.world_from_medium);
+                    wl(o, 2, format!("world_from_medium: {t}"));
+                }
+                d.params(o, 2, &m.plugin);
+            }
+            let camera = self
+                .camera_medium
+                .map_or("vacuum".to_owned(), |m| format!("#{m}"));
+            wl(o, 0, format!("camera medium: {camera}"));
         }
         wl(o, 0, format!("shapes: {}", self.shapes.len()));
         for (i, s) in self.shapes.iter().enumerate() {
@@ -173,6 +190,20 @@ impl SceneDescription {
         }
         out
     }
+}
+
+/// The media on either side, when there are any.
+fn media_line(o: &mut String, indent: usize, m: &MediumInterfaceDesc) {
+    if *m == MediumInterfaceDesc::default() {
+        return;
+    }
+    let name = |m: Option<usize>| m.map_or("vacuum".to_owned(), |m| format!("#{m}"));
+    let (inside, outside) = (name(m.inside), name(m.outside));
+    wl(
+        o,
+        indent,
+        format!("media: inside {inside}, outside {outside}"),
+    );
 }
 
 /// Writes one indented line.
@@ -230,6 +261,7 @@ impl Dump<'_> {
             indent + 1,
             format!("world_from_object: {}", animated(&s.world_from_object)),
         );
+        media_line(o, indent + 1, &s.media);
         if let Some(a) = &s.area_light {
             wl(
                 o,

@@ -22,8 +22,8 @@ pub use params::{Param, ParamList, ParamType, TextureRef, Values};
 pub use parser::{parse_file, parse_str};
 pub use paths::{io_message, resolve_path};
 pub use scene::{
-    CameraDesc, InstanceDesc, LightDesc, MaterialDesc, ObjectDesc, PluginDesc, SceneDescription,
-    ShapeDesc, TextureDesc, TextureValue,
+    CameraDesc, InstanceDesc, LightDesc, MaterialDesc, MediumDesc, MediumInterfaceDesc, ObjectDesc,
+    PluginDesc, SceneDescription, ShapeDesc, TextureDesc, TextureValue,
 };
 pub use source::{Loc, SourceFile};
 pub use suggest::closest;

@@ -301,19 +301,20 @@ impl Parser {
                 self.builder.texture(tex_name, &value, class, params, loc)
             }
             "MediumInterface" => {
-                self.string_arg(name, &loc)?;
-                if matches!(
+                // One name stands for both sides, as in pbrt-v3's parser.
+                let inside = self.string_arg(name, &loc)?;
+                let outside = if matches!(
                     self.peek()?,
                     Some(Token {
                         kind: TokenKind::Str(_),
                         ..
                     })
                 ) {
-                    self.next()?;
-                }
-                self.builder
-                    .unsupported_once(name, &loc, "participating media");
-                Ok(())
+                    self.string_arg(name, &loc)?
+                } else {
+                    inside.clone()
+                };
+                self.builder.medium_interface(&inside, &outside, &loc)
             }
             "Include" => {
                 let s = self.string_arg(name, &loc)?;

@@ -69,6 +69,29 @@ pub struct LightDesc {
     pub plugin: PluginDesc,
     /// World-from-light (pbrt-v3 lights use the CTM at the shutter's start).
     pub world_from_light: DMat4,
+    /// The media around it (pbrt-v3 gives a light the interface's outside medium).
+    pub media: MediumInterfaceDesc,
+}
+
+/// A participating medium from `MakeNamedMedium "name" "string type" ...`.
+#[derive(Debug, Clone)]
+pub struct MediumDesc {
+    /// Its name.
+    pub name: String,
+    /// Type (`"string type"`: homogeneous, heterogeneous) and parameters.
+    pub plugin: PluginDesc,
+    /// World-from-medium: the CTM where it was defined (pbrt-v3's `medium2world`).
+    pub world_from_medium: DMat4,
+}
+
+/// The media on either side of a surface, from the `MediumInterface` in effect: indices into
+/// [`SceneDescription::media`], `None` for vacuum (no name, or a name never defined).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MediumInterfaceDesc {
+    /// The medium on the side opposite the surface normal.
+    pub inside: Option<usize>,
+    /// The medium on the side the surface normal points to.
+    pub outside: Option<usize>,
 }
 
 /// A shape with everything the graphics state attached to it.
@@ -86,6 +109,8 @@ pub struct ShapeDesc {
     pub area_light: Option<Arc<PluginDesc>>,
     /// The triangles of a `trianglemesh` or `plymesh`, read and checked.
     pub mesh: Option<Arc<Mesh>>,
+    /// The `MediumInterface` in effect.
+    pub media: MediumInterfaceDesc,
 }
 
 /// An object definition (`ObjectBegin`/`ObjectEnd`).
@@ -143,6 +168,11 @@ pub struct SceneDescription {
     pub instances: Vec<InstanceDesc>,
     /// Warnings found while parsing.
     pub warnings: Vec<Warning>,
+    /// Participating media (`MakeNamedMedium`), in definition order.
+    pub media: Vec<MediumDesc>,
+    /// The camera's medium: the outside medium of the `MediumInterface` in effect at the end of
+    /// the world block (pbrt-v3 makes the camera there); `None` for vacuum.
+    pub camera_medium: Option<usize>,
 }
 
 impl SceneDescription {
@@ -166,6 +196,7 @@ impl SceneDescription {
         out.extend(self.materials.iter().map(|m| &m.plugin));
         out.extend(self.textures.iter().map(|t| &t.plugin));
         out.extend(self.lights.iter().map(|l| &l.plugin));
+        out.extend(self.media.iter().map(|m| &m.plugin));
         let shapes = self
             .shapes
             .iter()

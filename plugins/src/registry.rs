@@ -105,7 +105,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Integrator, "bdpt", "path"),
     (Kind::Integrator, "mlt", "path"),
     (Kind::Integrator, "sppm", "path"),
-    (Kind::Integrator, "volpath", "path"),
     (Kind::Integrator, "ambientocclusion", "path"),
     (Kind::Integrator, "whitted", "directlighting"),
 ];

@@ -27,6 +27,9 @@ pub struct Surface {
     pub material: Option<u32>,
     /// Index into [`Scene::lights`] when the primitive emits.
     pub area_light: Option<u32>,
+    /// The media on either side when it separates two (pbrt-v3's medium transition); `None`
+    /// when rays keep the medium they arrived in.
+    pub media: Option<crate::medium::MediumInterface>,
 }
 
 pub use acr_plugins::Dims;
@@ -52,6 +55,10 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Surfaces by index.
     pub surfaces: Vec<Surface>,
+    /// Participating media (`MakeNamedMedium`), indexed by [`Surface::media`].
+    pub media: Vec<crate::medium::Medium>,
+    /// The medium the camera sits in (`None`: vacuum).
+    pub camera_medium: Option<u32>,
     /// Active dimensions of the rendering space.
     pub dims: Dims,
     /// Centre of the scene's bounding sphere.
@@ -351,6 +358,7 @@ impl Scene {
         b.add_lights(world_radius, &main_dir)?;
         let materials =
             crate::material::build_materials(desc, &main_dir, render_from_world, b.warnings)?;
+        let media = crate::medium::build_media(&desc.media, render_from_world, b.warnings)?;
         let infinite_lights = b
             .lights
             .iter()
@@ -373,6 +381,8 @@ impl Scene {
             infinite_lights,
             materials,
             surfaces: b.surfaces,
+            media,
+            camera_medium: desc.camera_medium.map(|m| m as u32),
             dims,
             world_center,
             world_radius,

@@ -123,7 +123,19 @@ impl Builder<'_> {
         }
         let prims = self.within_range(geom, made.prims, p);
         let material = shape.material.map(|m| m as u32);
-        self.add_surfaces(geom, prims, material, area_light);
+        let (inside, outside) = (shape.media.inside, shape.media.outside);
+        // Only a surface between two different media changes a ray's medium (pbrt-v3's
+        // IsMediumTransition); any other keeps the medium the ray arrived in.
+        let media = (inside != outside).then_some(crate::medium::MediumInterface {
+            inside: inside.map(|m| m as u32),
+            outside: outside.map(|m| m as u32),
+        });
+        let surface = Surface {
+            material,
+            area_light: None,
+            media,
+        };
+        self.add_surfaces(geom, prims, surface, area_light);
         Ok(())
     }
 
@@ -378,20 +390,17 @@ impl Builder<'_> {
         prims
     }
 
-    /// Adds `prims` to `geom` with their surface of `material`: one surface for them all, or
+    /// Adds `prims` to `geom` with their `surface`: one surface for them all, or
     /// with an area light one each, its light waiting for the world's final layout.
     fn add_surfaces(
         &mut self,
         geom: &mut Geometry,
         prims: Vec<PrimKind>,
-        material: Option<u32>,
+        surface: Surface,
         area_light: Option<&Arc<PluginDesc>>,
     ) {
         let Some(light) = area_light else {
-            let surface = self.surface(Surface {
-                material,
-                area_light: None,
-            });
+            let surface = self.surface(surface);
             for kind in prims {
                 geom.push(Prim { kind, surface });
             }
@@ -399,10 +408,7 @@ impl Builder<'_> {
         };
         for kind in prims {
             // One light per primitive, as pbrt-v3 makes one DiffuseAreaLight per shape.
-            let surface = self.surface(Surface {
-                material,
-                area_light: None,
-            });
+            let surface = self.surface(surface);
             self.area_lights.push((Arc::clone(light), kind, surface));
             geom.push(Prim { kind, surface });
         }

@@ -18,6 +18,7 @@ use std::sync::Arc;
 
 mod blocks;
 mod materials;
+mod media;
 mod transforms;
 
 /// The state that `AttributeBegin` saves and `AttributeEnd` restores. Name tables are shared
@@ -30,6 +31,7 @@ struct GraphicsState {
     named_materials: Arc<IndexMap<String, usize>>,
     float_textures: Arc<IndexMap<String, usize>>,
     spectrum_textures: Arc<IndexMap<String, usize>>,
+    media: media::MediumNames,
 }
 
 /// The start and end current transformation matrices.
@@ -81,6 +83,7 @@ pub struct Builder {
     current_object: Option<(String, ObjectDesc)>,
     warned_once: HashSet<String>,
     ply_cache: HashMap<PathBuf, Arc<Mesh>>,
+    named_media: HashMap<String, usize>,
 }
 
 impl Builder {
@@ -113,6 +116,8 @@ impl Builder {
                 objects: IndexMap::new(),
                 instances: Vec::new(),
                 warnings: Vec::new(),
+                media: Vec::new(),
+                camera_medium: None,
             },
             main,
             phase: Phase::Options,
@@ -126,11 +131,13 @@ impl Builder {
                 named_materials: Arc::default(),
                 float_textures: Arc::default(),
                 spectrum_textures: Arc::default(),
+                media: media::MediumNames::default(),
             },
             stack: Vec::new(),
             current_object: None,
             warned_once: HashSet::new(),
             ply_cache: HashMap::new(),
+            named_media: HashMap::new(),
         }
     }
 
@@ -286,9 +293,11 @@ impl Builder {
                         "LightSource inside an object definition is not supported",
                     ));
                 }
+                let media = self.current_media();
                 self.scene.lights.push(LightDesc {
                     plugin,
                     world_from_light: self.ctm[0],
+                    media,
                 });
             }
             "AreaLightSource" => {
@@ -299,7 +308,7 @@ impl Builder {
                 self.require_world(directive, &loc)?;
                 self.shape(plugin)?;
             }
-            "MakeNamedMedium" => self.unsupported_once(directive, &loc, "participating media"),
+            "MakeNamedMedium" => self.make_named_medium(plugin)?,
             _ => {
                 return Err(Error::at(
                     &loc,
@@ -326,8 +335,10 @@ impl Builder {
             );
             area_light = None;
         }
+        let media = self.current_media();
         let shape = ShapeDesc {
             plugin,
+            media,
             world_from_object: self.animated(),
             reverse_orientation: self.graphics.reverse_orientation,
             material: self.graphics.material,
@@ -373,7 +384,8 @@ impl Builder {
     }
 
     /// The finished description.
-    pub fn finish(self) -> SceneDescription {
+    pub fn finish(mut self) -> SceneDescription {
+        self.scene.camera_medium = self.current_media().outside;
         self.scene
     }
 }

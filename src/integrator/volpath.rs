@@ -1,0 +1,512 @@
+//! `volpath`: pbrt-v3's `VolPathIntegrator` (src/integrators/volpath.cpp) with its
+//! `UniformSampleOneLight` and `EstimateDirect` for media (src/core/integrator.cpp), and
+//! `Scene::IntersectTr` and `VisibilityTester::Tr` (transmittance along shadow rays through
+//! media and through interface surfaces, `Material ""`). Every ray carries the medium it
+//! travels in: the camera's first, then the medium a surface between two media
+//! (`MediumInterface`) puts on the side the ray leaves by. See docs/media.md.
+
+use super::{Radiance, MAX_PASS_THROUGH};
+use crate::accel::Hit;
+use crate::bsdf::Bsdf;
+use crate::first_hit::FirstHitProbe;
+use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3, SHADOW_EPSILON};
+use crate::lightbvh::LightContext;
+use crate::lightdistrib::LightStrategy;
+use crate::medium::{HenyeyGreenstein, MediumInterface};
+use crate::sampling::power_heuristic;
+use crate::scene::{Scene, SceneHit, Surface};
+use crate::stream::SampleStream;
+
+/// `volpath`'s settings.
+#[derive(Clone, Copy, Debug)]
+pub struct VolPathSettings {
+    /// Longest path, in scattering events (surface or medium).
+    pub max_depth: u32,
+    /// Russian roulette once the throughput's largest channel is below this.
+    pub rr_threshold: f32,
+    /// How a light is chosen for next-event estimation.
+    pub light_strategy: LightStrategy,
+}
+
+/// A ray and the medium it travels in (`None`: vacuum).
+#[derive(Clone, Copy, Debug)]
+struct MediumRay {
+    ray: Ray,
+    medium: Option<u32>,
+}
+
+/// Where a path scatters: a surface with its BSDF, or a point in a medium with its phase
+/// function.
+enum Vertex<'a> {
+    Surface {
+        si: &'a SurfaceInteraction,
+        bsdf: &'a Bsdf,
+        /// The media on either side (both the ray's medium on a surface that is no transition).
+        media: MediumInterface,
+    },
+    Medium {
+        p: Vec3,
+        wo: Vec3,
+        time: f32,
+        phase: HenyeyGreenstein,
+        medium: Option<u32>,
+    },
+}
+
+/// A scattering direction sampled at a vertex.
+struct Scattered {
+    wi: Vec3,
+    /// The BSDF times the cosine, or the phase function's value.
+    f: Spectrum,
+    pdf: f32,
+    specular: bool,
+}
+
+impl Vertex<'_> {
+    fn p(&self) -> Vec3 {
+        match self {
+            Vertex::Surface { si, .. } => si.p,
+            Vertex::Medium { p, .. } => *p,
+        }
+    }
+
+    /// Where a light is chosen from (no normal in a medium: no cosine applies there).
+    fn light_context(&self) -> LightContext {
+        match self {
+            Vertex::Surface { si, .. } => LightContext {
+                p: si.p,
+                n: si.shading_n,
+            },
+            Vertex::Medium { p, .. } => LightContext {
+                p: *p,
+                n: Vec3::ZERO,
+            },
+        }
+    }
+
+    /// The scattering function (times the cosine on a surface) for `wi`, and its density.
+    fn f_pdf(&self, wi: Vec3) -> (Spectrum, f32) {
+        match self {
+            Vertex::Surface { si, bsdf, .. } => (
+                bsdf.f(si.wo, wi) * wi.dot(si.shading_n).abs(),
+                bsdf.pdf(si.wo, wi),
+            ),
+            Vertex::Medium { wo, phase, .. } => {
+                let p = phase.p(*wo, wi);
+                (Spectrum::splat(p), p)
+            }
+        }
+    }
+
+    /// Samples a direction to continue in.
+    fn sample(&self, stream: &mut SampleStream) -> Option<Scattered> {
+        match self {
+            Vertex::Surface { si, bsdf, .. } => {
+                let u_lobe = stream.next_1d();
+                let u = stream.next_2d();
+                let s = bsdf.sample_f(si.wo, u, u_lobe)?;
+                Some(Scattered {
+                    wi: s.wi,
+                    f: s.f * s.wi.dot(si.shading_n).abs(),
+                    pdf: s.pdf,
+                    specular: s.specular,
+                })
+            }
+            Vertex::Medium { wo, phase, .. } => {
+                let (wi, p) = phase.sample_p(*wo, stream.next_2d());
+                Some(Scattered {
+                    wi,
+                    f: Spectrum::splat(p),
+                    pdf: p,
+                    specular: false,
+                })
+            }
+        }
+    }
+
+    /// The ray leaving along `d`, in the medium on that side.
+    fn spawn(&self, d: Vec3) -> MediumRay {
+        match self {
+            Vertex::Surface { si, media, .. } => MediumRay {
+                ray: si.spawn_ray(d),
+                medium: media.toward(si.n, d),
+            },
+            Vertex::Medium {
+                p, time, medium, ..
+            } => MediumRay {
+                ray: Ray::new(*p, d, *time),
+                medium: *medium,
+            },
+        }
+    }
+
+    /// The shadow ray towards `target`, its end parameter, in the medium on that side.
+    fn spawn_to(&self, target: Vec3) -> (MediumRay, f32) {
+        match self {
+            Vertex::Surface { si, media, .. } => {
+                let (ray, t_max) = si.spawn_ray_to(target);
+                let medium = media.toward(si.n, ray.d);
+                (MediumRay { ray, medium }, t_max)
+            }
+            Vertex::Medium {
+                p, time, medium, ..
+            } => (
+                MediumRay {
+                    ray: Ray::new(*p, target - *p, *time),
+                    medium: *medium,
+                },
+                1.0 - SHADOW_EPSILON,
+            ),
+        }
+    }
+}
+
+/// The surface's media as seen by a ray in `medium`: its own where it is a transition, else
+/// `medium` on both sides (pbrt-v3's `GeometricPrimitive::Intersect`).
+#[inline]
+fn media_at(surface: &Surface, medium: Option<u32>) -> MediumInterface {
+    surface.media.unwrap_or(MediumInterface {
+        inside: medium,
+        outside: medium,
+    })
+}
+
+/// A ray's closest hit before its interaction is computed (which a path that scatters in a
+/// medium first, or a shadow ray that is blocked, never needs).
+#[derive(Clone, Copy)]
+struct RawHit {
+    hit: Hit,
+    surface: Surface,
+}
+
+impl RawHit {
+    /// The hit, resolved for `ray` (the ray that found it).
+    #[inline]
+    fn resolve(&self, scene: &Scene, ray: &Ray) -> SceneHit {
+        SceneHit {
+            si: scene.accel.interaction(ray, &self.hit),
+            surface: self.surface,
+        }
+    }
+}
+
+/// The closest hit along `ray` before parameter `t_max`.
+#[inline]
+fn intersect(scene: &Scene, ray: &Ray, t_max: f32) -> Option<RawHit> {
+    let hit = scene.accel.intersect(ray, t_max)?;
+    Some(RawHit {
+        hit,
+        surface: scene.surfaces[hit.prim.surface as usize],
+    })
+}
+
+/// Transmittance through `medium` along `ray` up to `t_max`.
+#[inline]
+fn medium_tr(
+    scene: &Scene,
+    medium: Option<u32>,
+    ray: &Ray,
+    t_max: f32,
+    stream: &mut SampleStream,
+) -> Spectrum {
+    match medium {
+        Some(m) => scene.media[m as usize].tr(ray, t_max, &mut || stream.next_1d()),
+        None => Spectrum::ONE,
+    }
+}
+
+/// pbrt-v3's `VisibilityTester::Tr`: the transmittance from `from` to `target`, zero when a
+/// surface with a material blocks it; interface surfaces are crossed, changing the medium.
+fn transmittance_to(
+    scene: &Scene,
+    from: &Vertex,
+    target: Vec3,
+    stream: &mut SampleStream,
+    rays: &mut u32,
+) -> Spectrum {
+    let (mut mr, mut t_max) = from.spawn_to(target);
+    let mut tr = Spectrum::ONE;
+    for _ in 0..MAX_PASS_THROUGH {
+        *rays += 1;
+        let hit = intersect(scene, &mr.ray, t_max);
+        if hit.is_some_and(|h| h.surface.material.is_some()) {
+            return Spectrum::ZERO;
+        }
+        let t_end = hit.map_or(t_max, |h| h.hit.t);
+        tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
+        let Some(h) = hit else {
+            return tr;
+        };
+        if tr == Spectrum::ZERO {
+            return tr;
+        }
+        let si = scene.accel.interaction(&mr.ray, &h.hit);
+        let (ray, t) = si.spawn_ray_to(target);
+        mr = MediumRay {
+            medium: media_at(&h.surface, mr.medium).toward(si.n, ray.d),
+            ray,
+        };
+        t_max = t;
+    }
+    Spectrum::ZERO
+}
+
+/// pbrt-v3's `Scene::IntersectTr`: the first surface with a material along `mr`, crossing
+/// interfaces (with the ray that found it), and the transmittance up to it (or to infinity
+/// when none is found).
+fn intersect_tr(
+    scene: &Scene,
+    mut mr: MediumRay,
+    stream: &mut SampleStream,
+    rays: &mut u32,
+) -> (Option<(RawHit, Ray)>, Spectrum) {
+    let mut tr = Spectrum::ONE;
+    for _ in 0..MAX_PASS_THROUGH {
+        *rays += 1;
+        let hit = intersect(scene, &mr.ray, f32::INFINITY);
+        let t_end = hit.map_or(f32::INFINITY, |h| h.hit.t);
+        tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
+        let Some(h) = hit else {
+            return (None, tr);
+        };
+        if h.surface.material.is_some() {
+            return (Some((h, mr.ray)), tr);
+        }
+        let si = scene.accel.interaction(&mr.ray, &h.hit);
+        let d = mr.ray.d;
+        mr = MediumRay {
+            medium: media_at(&h.surface, mr.medium).toward(si.n, d),
+            ray: si.spawn_ray(d),
+        };
+    }
+    (None, Spectrum::ZERO)
+}
+
+/// pbrt-v3's `EstimateDirect` with media: a light sample with the transmittance to it, and
+/// (for lights that are not delta) a BSDF or phase sample that finds the light through
+/// media and interfaces, combined by the power heuristic.
+fn estimate_direct(
+    scene: &Scene,
+    v: &Vertex,
+    light_index: usize,
+    stream: &mut SampleStream,
+    rays: &mut u32,
+) -> Spectrum {
+    let light = &scene.lights[light_index];
+    let mut ld = Spectrum::ZERO;
+    let p = v.p();
+    if let Some(ls) = light.sample_li(&scene.accel.world, p, stream.next_2d()) {
+        if ls.pdf > 0.0 && ls.li != Spectrum::ZERO {
+            let (f, scattering_pdf) = v.f_pdf(ls.wi);
+            if f != Spectrum::ZERO {
+                let li = ls.li * transmittance_to(scene, v, ls.p, stream, rays);
+                if li != Spectrum::ZERO {
+                    ld += if light.is_delta() {
+                        f * li / ls.pdf
+                    } else {
+                        f * li * power_heuristic(1.0, ls.pdf, 1.0, scattering_pdf) / ls.pdf
+                    };
+                }
+            }
+        }
+    }
+    if light.is_delta() {
+        return ld;
+    }
+    let Some(s) = v.sample(stream) else {
+        return ld;
+    };
+    if s.specular || s.pdf <= 0.0 || s.f == Spectrum::ZERO {
+        return ld;
+    }
+    let (hit, tr) = intersect_tr(scene, v.spawn(s.wi), stream, rays);
+    let (li, light_pdf) = match hit {
+        Some((h, ray)) if h.surface.area_light == Some(light_index as u32) => {
+            let si = scene.accel.interaction(&ray, &h.hit);
+            (
+                light.l(&si, -s.wi),
+                light.pdf_area_hit(&scene.accel.world, p, si.p, si.n),
+            )
+        }
+        Some(_) => return ld,
+        None => (light.le(s.wi), light.pdf_le(s.wi)),
+    };
+    if light_pdf <= 0.0 || li == Spectrum::ZERO {
+        return ld;
+    }
+    let w = power_heuristic(1.0, s.pdf, 1.0, light_pdf);
+    ld + s.f * li * tr * w / s.pdf
+}
+
+/// pbrt-v3's `UniformSampleOneLight` with media, the light chosen by `strategy` at `v`.
+fn sample_one_light(
+    scene: &Scene,
+    v: &Vertex,
+    strategy: LightStrategy,
+    stream: &mut SampleStream,
+    rays: &mut u32,
+) -> Spectrum {
+    if scene.lights.is_empty() {
+        return Spectrum::ZERO;
+    }
+    let u = stream.next_1d();
+    match scene.choose_light(strategy, v.light_context(), u) {
+        Some((i, pdf)) if pdf > 0.0 => estimate_direct(scene, v, i, stream, rays) / pdf,
+        _ => Spectrum::ZERO,
+    }
+}
+
+/// Emission the path finds on a surface or, escaping, from the infinite lights.
+fn emission(scene: &Scene, hit: Option<&SceneHit>, d: Vec3) -> Spectrum {
+    match hit {
+        Some(h) => h.surface.area_light.map_or(Spectrum::ZERO, |li| {
+            scene.lights[li as usize].l(&h.si, h.si.wo)
+        }),
+        None => scene
+            .infinite_lights
+            .iter()
+            .map(|&i| scene.lights[i as usize].le(d.normalize()))
+            .sum(),
+    }
+}
+
+/// The volumetric path tracer's estimate of the radiance along `ray`, which starts in the
+/// camera's medium.
+pub(super) fn volpath_li(
+    scene: &Scene,
+    ray: Ray,
+    mut diff: Option<&crate::geometry::RayDifferentials>,
+    stream: &mut SampleStream,
+    settings: VolPathSettings,
+) -> Radiance {
+    let mut l = Spectrum::ZERO;
+    let mut beta = Spectrum::ONE;
+    let mut rays = 0u32;
+    let mut specular_bounce = false;
+    let mut eta_scale = 1.0f32;
+    let mut probe = FirstHitProbe::default();
+    let mut mr = MediumRay {
+        ray,
+        medium: scene.camera_medium,
+    };
+    let mut bounces = 0u32;
+    let mut pass_through = 0u32;
+    loop {
+        rays += 1;
+        let hit = intersect(scene, &mr.ray, f32::INFINITY);
+        let t_hit = hit.map_or(f32::INFINITY, |h| h.hit.t);
+        let mut scatter_t = None;
+        if let Some(m) = mr.medium {
+            let medium = &scene.media[m as usize];
+            let s = medium.sample(&mr.ray, t_hit, &mut || stream.next_1d());
+            beta *= s.weight;
+            scatter_t = s.t;
+        }
+        if beta == Spectrum::ZERO || !crate::geometry::is_valid_radiance(beta) {
+            break;
+        }
+        if let (Some(t), Some(m)) = (scatter_t, mr.medium) {
+            // Scattering in the medium.
+            if bounces >= settings.max_depth {
+                break;
+            }
+            let medium = &scene.media[m as usize];
+            let p = mr.ray.at(t);
+            probe.travel(mr.ray.o, p);
+            probe.medium(medium.albedo());
+            let v = Vertex::Medium {
+                p,
+                wo: -mr.ray.d.normalize(),
+                time: mr.ray.time,
+                phase: medium.phase,
+                medium: mr.medium,
+            };
+            l += beta * sample_one_light(scene, &v, settings.light_strategy, stream, &mut rays);
+            let Some(s) = v.sample(stream) else {
+                break;
+            };
+            mr = v.spawn(s.wi);
+            specular_bounce = false;
+        } else {
+            let hit = hit.map(|h| h.resolve(scene, &mr.ray));
+            if bounces == 0 || specular_bounce {
+                l += beta * emission(scene, hit.as_ref(), mr.ray.d);
+            }
+            let Some(hit) = hit else {
+                break;
+            };
+            if bounces >= settings.max_depth {
+                break;
+            }
+            let mut si = hit.si;
+            if let Some(d) = diff.take() {
+                si.compute_differentials(d);
+            }
+            probe.travel(mr.ray.o, si.p);
+            let media = media_at(&hit.surface, mr.medium);
+            let Some(material) = hit.surface.material else {
+                // An interface: the ray goes on in the same direction (not a bounce).
+                pass_through += 1;
+                if pass_through > MAX_PASS_THROUGH {
+                    break;
+                }
+                mr = MediumRay {
+                    medium: media.toward(si.n, mr.ray.d),
+                    ray: si.spawn_ray(mr.ray.d),
+                };
+                continue;
+            };
+            let material = &scene.materials[material as usize];
+            let si = material.shading(&si);
+            let bsdf = material.bsdf(&si);
+            probe.surface(&si, &bsdf);
+            let v = Vertex::Surface {
+                si: &si,
+                bsdf: &bsdf,
+                media,
+            };
+            if bsdf.has_non_specular() {
+                l += beta * sample_one_light(scene, &v, settings.light_strategy, stream, &mut rays);
+            }
+            let Some(s) = v.sample(stream) else {
+                break;
+            };
+            if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
+                break;
+            }
+            beta *= s.f / s.pdf;
+            specular_bounce = s.specular;
+            let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
+            if s.specular && transmitted {
+                let eta = bsdf.eta();
+                eta_scale *= if si.wo.dot(si.n) > 0.0 {
+                    eta * eta
+                } else {
+                    1.0 / (eta * eta)
+                };
+            }
+            mr = v.spawn(s.wi);
+            // Subsurface hook: a material with a BSSRDF would sample its exit point here and
+            // continue from there, as pbrt-v3's volpath does (docs/media.md).
+        }
+        pass_through = 0;
+        if !crate::geometry::is_valid_radiance(beta) {
+            break;
+        }
+        let rr_beta = beta * eta_scale;
+        let m = rr_beta.max_element();
+        if m < settings.rr_threshold && bounces > 3 {
+            let q = (1.0 - m).max(0.05);
+            if stream.next_1d() < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+        bounces += 1;
+    }
+    Radiance {
+        l,
+        rays,
+        first_hit: probe.features(),
+    }
+}
