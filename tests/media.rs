@@ -113,6 +113,26 @@ fn an_absorbing_sphere_transmits_exp_minus_optical_depth() {
     );
 }
 
+/// pbrt-v3's `bdpt` and `mlt` render media, so on a scene with media they map to `volpath`
+/// (the same image), with a located warning; `sppm` maps to `path` as elsewhere.
+#[test]
+fn bdpt_and_mlt_on_a_medium_scene_render_as_volpath() {
+    let medium = "\"rgb sigma_a\" [0.25 0.5 1.5] \"rgb sigma_s\" [0.5 0.5 0.5]";
+    let (_, volpath, _) = render_text(&sphere_scene(medium, "\"volpath\""), 8);
+    for name in ["bdpt", "mlt"] {
+        let (warnings, image, _) = render_text(&sphere_scene(medium, &format!("\"{name}\"")), 8);
+        assert_eq!(image, volpath, "{name}");
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        let w = &warnings[0];
+        assert!(w.message.contains("volpath") && w.loc.is_some(), "{w:?}");
+    }
+    let (warnings, _, _) = render_text(&sphere_scene(medium, "\"sppm\""), 2);
+    assert!(
+        warnings.iter().any(|w| w.message.contains("\"path\"")),
+        "{warnings:?}"
+    );
+}
+
 /// A white furnace: a medium that only scatters, in a sphere under a uniform sky of
 /// radiance 1, sends back exactly 1 in every direction; the light samples, the phase samples
 /// and their MIS weights, and the transmittance along shadow rays through the interface must

@@ -420,6 +420,42 @@ fn new_features_agree_with_pbrt_v3() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// `volpath` samples a BSSRDF's exit point as `path` does (pbrt-v3's volpath has the same
+/// subsurface block): the two subsurface scenes rendered by it meet the rule of
+/// [`new_features_agree_with_pbrt_v3`] against pbrt-v3's own `volpath` at 16 spp
+/// (`-volpath-pbrt16`: the scene with its Integrator line changed, scenes/pbrt-v3/README.md).
+#[test]
+fn volpath_renders_subsurface_materials() {
+    let dir = root().join("scenes/pbrt-v3");
+    for stem in ["subsurface", "kdsubsurface"] {
+        let mut desc = parse_file(&dir.join(format!("{stem}.pbrt"))).unwrap();
+        desc.integrator.as_mut().unwrap().kind = "volpath".into();
+        let r = render_desc(&desc, 16, 11);
+        let read = |name: String| {
+            acr::image_io::read_image(&dir.join("references").join(name), false)
+                .unwrap()
+                .pixels
+        };
+        let reference = read(format!("{stem}-ref1024.exr"));
+        let pbrt = read(format!("{stem}-volpath-pbrt16.exr"));
+        let (mse, pbrt_mse) = (
+            srgb8_mse(&r.pixels, &reference),
+            srgb8_mse(&pbrt, &reference),
+        );
+        let lum = |p: &[Spectrum]| f64::from(acr::spectrum_luminance(mean(p)));
+        let ratio = lum(&r.pixels) / lum(&reference);
+        eprintln!(
+            "{stem} (volpath): MSE ratio {:.2}, mean {ratio:.4}",
+            mse / pbrt_mse
+        );
+        assert!(
+            mse <= 1.25 * pbrt_mse,
+            "{stem}: {mse:.3e} vs {pbrt_mse:.3e}"
+        );
+        assert!((ratio - 1.0).abs() < 0.01, "{stem}: mean ratio {ratio:.4}");
+    }
+}
+
 /// The public pbrt-v3 scenes without a reference render: at reduced resolution and 2 spp they
 /// build and render with no sample dropped and a lit, finite image.
 #[test]

@@ -13,31 +13,34 @@ use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
 use crate::stream::SampleStream;
 
-/// Follows a path that entered material `material` (whose BSSRDF at the entry point is
-/// `bssrdf`, at time `time`) to its exit point: multiplies `beta` by Sp / pdf, adds the light
-/// sampled there to `l`, multiplies `beta` by the adapter BSDF's sample and records that
-/// scattering in `last` (for the MIS weight of the emission the next ray finds). Returns the
-/// ray that continues the path; `None` ends it (no exit point found, nothing to sample), as
-/// pbrt-v3's `break`. Every probe and shadow ray is counted in `rays`.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn scatter(
+/// An exit point found by [`find_exit`]: its interaction (looking out along its shading
+/// normal, pbrt-v3's `Sample_S`) and the index of its surface in the scene.
+pub(super) struct Exit {
+    /// The exit point, `wo` its shading normal.
+    pub si: SurfaceInteraction,
+    /// Its surface (`Scene::surfaces`), whose media the path leaves into.
+    pub surface: u32,
+}
+
+/// Finds where a path that entered material `material` (whose BSSRDF at the entry point is
+/// `bssrdf`, at time `time`) leaves it, and multiplies `beta` by Sp / pdf: pbrt-v3's
+/// `SeparableBSSRDF::Sample_S`, shared by `path` and `volpath`. `None` ends the path (no exit
+/// point found), as pbrt-v3's `break`. Every probe ray is counted in `rays`.
+pub(super) fn find_exit(
     scene: &Scene,
     bssrdf: &TabulatedBssrdf,
     material: u32,
     time: f32,
-    strategy: LightStrategy,
     stream: &mut SampleStream,
     beta: &mut Spectrum,
-    l: &mut Spectrum,
-    last: &mut LastScatter,
     rays: &mut u32,
-) -> Option<Ray> {
+) -> Option<Exit> {
     let u1 = stream.next_1d();
     let u2 = stream.next_2d();
     let probe = bssrdf.probe(u1, u2)?;
     // Every surface of the same material along the segment (pbrt-v3 compares material
     // pointers; acr's materials are indices). Other surfaces are crossed.
-    let mut found: Vec<SurfaceInteraction> = Vec::new();
+    let mut found: Vec<(SurfaceInteraction, u32)> = Vec::new();
     let mut ray = Ray::new(probe.start, probe.end - probe.start, time);
     let mut t_max = 1.0 - crate::geometry::SHADOW_EPSILON;
     for _ in 0..MAX_PASS_THROUGH {
@@ -51,7 +54,7 @@ pub(super) fn scatter(
         let si = scene.accel.interaction(&ray, &hit);
         (ray, t_max) = si.spawn_ray_to(probe.end);
         if scene.surfaces[hit.prim.surface as usize].material == Some(material) {
-            found.push(si);
+            found.push((si, hit.prim.surface));
         }
     }
     if found.is_empty() {
@@ -59,7 +62,7 @@ pub(super) fn scatter(
     }
     let n = found.len();
     let chosen = ((probe.u_choice * n as f32) as usize).min(n - 1);
-    let mut pi = found[chosen];
+    let (mut pi, surface) = found[chosen];
     let pdf = bssrdf.pdf_sp(pi.p, pi.n) / n as f32;
     let sp = bssrdf.sp(pi.p);
     if sp == Spectrum::ZERO || pdf.is_nan() || pdf <= 0.0 {
@@ -71,6 +74,29 @@ pub(super) fn scatter(
     }
     // pbrt-v3's `Sample_S`: the exit point looks out along its shading normal.
     pi.wo = pi.shading_n;
+    Some(Exit { si: pi, surface })
+}
+
+/// Follows a path that entered material `material` (whose BSSRDF at the entry point is
+/// `bssrdf`, at time `time`) to its exit point ([`find_exit`]), adds the light sampled there
+/// to `l`, multiplies `beta` by the adapter BSDF's sample and records that scattering in
+/// `last` (for the MIS weight of the emission the next ray finds). Returns the ray that
+/// continues the path; `None` ends it, as pbrt-v3's `break`. Every probe and shadow ray is
+/// counted in `rays`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn scatter(
+    scene: &Scene,
+    bssrdf: &TabulatedBssrdf,
+    material: u32,
+    time: f32,
+    strategy: LightStrategy,
+    stream: &mut SampleStream,
+    beta: &mut Spectrum,
+    l: &mut Spectrum,
+    last: &mut LastScatter,
+    rays: &mut u32,
+) -> Option<Ray> {
+    let pi = find_exit(scene, bssrdf, material, time, stream, beta, rays)?.si;
     let bsdf = adapter_bsdf(&pi, bssrdf.eta);
     last.ctx = None;
     if !scene.lights.is_empty() {

@@ -8,6 +8,7 @@
 use super::{Radiance, MAX_PASS_THROUGH};
 use crate::accel::Hit;
 use crate::bsdf::Bsdf;
+use crate::bssrdf::adapter_bsdf;
 use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, Spectrum, SurfaceInteraction, Vec3, SHADOW_EPSILON};
 use crate::lightbvh::LightContext;
@@ -456,6 +457,7 @@ pub(super) fn volpath_li(
                 };
                 continue;
             };
+            let material_index = material;
             let material = &scene.materials[material as usize];
             let si = material.shading(&si);
             let bsdf = material.bsdf(&si);
@@ -486,8 +488,39 @@ pub(super) fn volpath_li(
                 };
             }
             mr = v.spawn(s.wi);
-            // Subsurface hook: a material with a BSSRDF would sample its exit point here and
-            // continue from there, as pbrt-v3's volpath does (docs/media.md).
+            // Transmitted into a subsurface material: the path leaves from an exit point, as
+            // pbrt-v3's volpath (docs/subsurface.md).
+            if let Some(bssrdf) = transmitted.then(|| material.bssrdf(&si)).flatten() {
+                let Some(exit) = super::subsurface::find_exit(
+                    scene,
+                    &bssrdf,
+                    material_index,
+                    si.time,
+                    stream,
+                    &mut beta,
+                    &mut rays,
+                ) else {
+                    break;
+                };
+                let adapter = adapter_bsdf(&exit.si, bssrdf.eta);
+                // The exit surface's media, or, on a surface that is no transition, those
+                // the path entered by.
+                let v = Vertex::Surface {
+                    si: &exit.si,
+                    bsdf: &adapter,
+                    media: scene.surfaces[exit.surface as usize].media.unwrap_or(media),
+                };
+                l += beta * sample_one_light(scene, &v, settings.light_strategy, stream, &mut rays);
+                let Some(s) = v.sample(stream) else {
+                    break;
+                };
+                if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
+                    break;
+                }
+                beta *= s.f / s.pdf;
+                specular_bounce = s.specular;
+                mr = v.spawn(s.wi);
+            }
         }
         pass_through = 0;
         if !crate::geometry::is_valid_radiance(beta) {
