@@ -6,7 +6,6 @@
 //! step that uses it is `src/integrator/subsurface.rs`.
 
 pub mod adapter;
-pub mod measured;
 pub mod table;
 pub mod tabulated;
 

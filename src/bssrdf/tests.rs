@@ -5,6 +5,7 @@
 
 use super::*;
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec2, Vec3};
+use crate::medium::presets as measured;
 
 /// Relative closeness, for values pbrt-v3 computes in the same f32 steps.
 fn close(a: f32, b: f32, rel: f32) -> bool {

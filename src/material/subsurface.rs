@@ -8,8 +8,9 @@
 use super::glass::Glass;
 use super::shared::{clamp0, remap_roughness};
 use crate::bsdf::Bsdf;
-use crate::bssrdf::{measured, table_for, BssrdfTable, TabulatedBssrdf};
+use crate::bssrdf::{table_for, BssrdfTable, TabulatedBssrdf};
 use crate::geometry::{Spectrum, SurfaceInteraction};
+use crate::medium::presets as measured;
 use crate::texture::{SpectrumTexture, Texture, TextureBuilder};
 use acr_parser::{Error, Loc, ParamList, Result};
 use std::sync::Arc;

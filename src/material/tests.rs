@@ -390,7 +390,7 @@ fn subsurface_materials_build_with_pbrt_v3_parameters() {
     assert!(w.is_empty(), "{w:?}");
     let b = m.last().unwrap().bssrdf(&si()).unwrap();
     // Skin1's coefficients times the scale; g forced to 0 by the name (its table is g = 0's).
-    let (a, s) = crate::bssrdf::measured::lookup("Skin1").unwrap();
+    let (a, s) = crate::medium::presets::lookup("Skin1").unwrap();
     assert!(
         (b.sigma_t - 2.0 * (a + s)).abs().max_element() < 1e-6,
         "{}",

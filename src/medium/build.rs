@@ -34,10 +34,10 @@ fn coefficients(m: &MediumDesc, warnings: &mut Vec<Warning>) -> Result<(Spectrum
     let mut sigma_a = Spectrum::new(0.0011, 0.0024, 0.014);
     let mut sigma_s = Spectrum::new(2.55, 3.21, 3.77);
     if let Some(preset) = params.string("preset")?.filter(|p| !p.is_empty()) {
-        match super::presets::medium_preset(preset) {
+        match super::presets::lookup(preset) {
             Some((a, s)) => (sigma_a, sigma_s) = (a, s),
             None => {
-                let hint = acr_parser::closest(preset, super::presets::preset_names())
+                let hint = acr_parser::closest(preset, super::presets::names())
                     .map_or(String::new(), |k| format!(" (did you mean \"{k}\"?)"));
                 warnings.push(Warning::at(
                     loc_of(params, "preset", loc),

@@ -1,5 +1,6 @@
 //! pbrt-v3's table of measured scattering coefficients (`GetMediumScatteringProperties` in
-//! src/core/medium.cpp), which `MakeNamedMedium "preset"` names: per name the reduced
+//! src/core/medium.cpp), which `MakeNamedMedium "preset"` and the `subsurface` material's
+//! `name` name: per name the reduced
 //! scattering coefficient sigma'_s and the absorption coefficient sigma_a, in mm^-1, as RGB.
 //! Jensen et al. 2001 ("A Practical Model for Subsurface Light Transport") and Narasimhan et
 //! al. 2006 ("Acquiring Scattering Properties of Participating Media by Dilution").
@@ -199,7 +200,7 @@ const TABLE: &[(&str, [f32; 3], [f32; 3])] = &[
 
 /// The measured (sigma_a, sigma_s) of preset `name` (names as pbrt-v3 spells them, case
 /// included); `None` when the table has no such name.
-pub fn medium_preset(name: &str) -> Option<(Spectrum, Spectrum)> {
+pub fn lookup(name: &str) -> Option<(Spectrum, Spectrum)> {
     TABLE
         .iter()
         .find(|(n, _, _)| *n == name)
@@ -207,7 +208,7 @@ pub fn medium_preset(name: &str) -> Option<(Spectrum, Spectrum)> {
 }
 
 /// Every preset's name, for suggestions.
-pub fn preset_names() -> impl Iterator<Item = &'static str> {
+pub fn names() -> impl Iterator<Item = &'static str> {
     TABLE.iter().map(|(n, _, _)| *n)
 }
 
@@ -219,10 +220,15 @@ mod tests {
     #[test]
     fn pbrt_v3s_table() {
         assert_eq!(TABLE.len(), 47);
-        let (a, s) = medium_preset("Wholemilk").unwrap();
+        let (a, s) = lookup("Wholemilk").unwrap();
         assert_eq!(a, Spectrum::new(0.0011, 0.0024, 0.014));
         assert_eq!(s, Spectrum::new(2.55, 3.21, 3.77));
-        assert!(medium_preset("wholemilk").is_none());
-        assert!(medium_preset("Pacific Ocean Surface Water").is_some());
+        assert!(lookup("wholemilk").is_none());
+        assert!(lookup("Pacific Ocean Surface Water").is_some());
+        let (a, s) = lookup("Skin1").unwrap();
+        assert_eq!(a, Spectrum::new(0.032, 0.17, 0.48));
+        assert_eq!(s, Spectrum::new(0.74, 0.88, 1.01));
+        let (a, s) = lookup("Ketchup").unwrap();
+        assert_eq!((a.z, s.x), (1.45, 0.18));
     }
 }
