@@ -6,19 +6,35 @@
 use acr_parser::{parse_file, Error, SceneDescription};
 use std::path::{Path, PathBuf};
 
+/// A temporary folder, removed when dropped.
+struct TempFolder(PathBuf);
+
+impl std::ops::Deref for TempFolder {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempFolder {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
 /// A fresh folder holding `files` (name, text).
-fn folder(name: &str, files: &[(&str, &str)]) -> PathBuf {
+fn folder(name: &str, files: &[(&str, &str)]) -> TempFolder {
     let dir = std::env::temp_dir().join(format!("acr-include-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     for (file, text) in files {
         std::fs::write(dir.join(file), text).unwrap();
     }
-    dir
+    TempFolder(dir)
 }
 
 /// Parses `main` with `inc.pbrt` beside it.
-fn parse(name: &str, main: &str, inc: &str) -> (Result<SceneDescription, Error>, PathBuf) {
+fn parse(name: &str, main: &str, inc: &str) -> (Result<SceneDescription, Error>, TempFolder) {
     let dir = folder(name, &[("main.pbrt", main), ("inc.pbrt", inc)]);
     (parse_file(&dir.join("main.pbrt")), dir)
 }
