@@ -94,9 +94,9 @@ pub const NFOR_ROW: Row = Row {
                0.12x",
 };
 
-/// nfor's reconstruction, in thread-seconds per pixel: its CPU time 3.3e-6 to 4.5e-6 a pixel at
-/// 256x256, 320x240 and 1024x1024 (fits on every second pixel), 0.33x to 0.43x the 9.3e-6 to
-/// 1.06e-5 it took before (docs/reconstruction.md, "NFOR", cost).
+/// nfor's reconstruction, in thread-seconds per pixel: its CPU time 3.8e-6 to 4.1e-6 a pixel at
+/// 256x256, 320x240 and 1024x1024 (fits on every second pixel), 0.34x to 0.39x the 9.9e-6 to
+/// 1.16e-5 it took before (docs/reconstruction.md, "NFOR", cost).
 const NFOR_THREAD_SECONDS_PER_PIXEL: f64 = 4.0e-6;
 
 /// The largest share of the time limit nfor's reconstruction may take for the auto pipeline to
