@@ -29,8 +29,9 @@ use std::ops::Range;
 pub const RADIUS: u32 = 3;
 /// The NL-means patch radius by default (NFOR's and Tungsten's).
 pub const PATCH: u32 = 3;
-/// The feature prefilter's window radius by default.
-pub const PREFILTER_RADIUS: u32 = 3;
+/// The feature prefilter's window radius by default: 2 measured within 3% of 3 on the five
+/// scenes at 8 and 64 spp, at about half the prefilter's time (docs/reconstruction.md, "Cost").
+pub const PREFILTER_RADIUS: u32 = 2;
 /// The radius of the window that smooths the MSE estimates and the choice.
 pub const SELECT_RADIUS: u32 = 3;
 /// The ridge on the slopes, relative to the weights' sum.
@@ -39,6 +40,9 @@ pub const RIDGE: f64 = 1e-3;
 /// a halo of the windows' reach, so that the filter's planes are a band's, not the image's
 /// (docs/reconstruction.md, "Memory").
 pub const BAND: u32 = 256;
+/// The regressions' fits on every STRIDE-th pixel in each direction by default
+/// (docs/reconstruction.md, "Cost").
+pub const STRIDE: u32 = 2;
 /// The NL-means bandwidths of the regression's candidates. NFOR's are 0.5 and 1 with a
 /// variance shared by the halves; with each half's own (unbiased) variance, 1 and 2 measured
 /// lower (docs/reconstruction.md).
@@ -63,6 +67,8 @@ pub struct NforFilter {
     prefilter_radius: usize,
     select_radius: usize,
     ridge: f32,
+    /// The regressions fit every `stride`-th pixel in each direction.
+    stride: usize,
     /// Whether NFOR's second pass runs.
     second_pass: bool,
     /// The rows of a band (0: the whole image at once).
@@ -86,10 +92,17 @@ impl NforFilter {
             prefilter_radius: prefilter as usize,
             select_radius: select as usize,
             ridge: ridge as f32,
+            stride: STRIDE as usize,
             second_pass: true,
             band: BAND as usize,
             kernel: BoxFilter::new(0.5, 0.5),
         }
+    }
+
+    /// The filter with its regressions' fits on every `stride`-th pixel in each direction.
+    pub fn with_stride(mut self, stride: u32) -> Self {
+        self.stride = stride.max(1) as usize;
+        self
     }
 
     /// The filter with NFOR's second pass on or off.
@@ -190,6 +203,7 @@ impl NforFilter {
                 hit,
                 radius: self.radius,
                 ridge: self.ridge,
+                stride: self.stride,
             };
             let guide = Guide {
                 image: &inp.color[1 - h],
@@ -272,6 +286,7 @@ impl NforFilter {
             hit: &inp.hit,
             radius: self.radius,
             ridge: self.ridge,
+            stride: self.stride,
         };
         let guide = Guide {
             image: first,
@@ -361,7 +376,7 @@ pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
             ParamSpec::new(
                 "prefilter",
                 ParamType::Integer,
-                "3",
+                "2",
                 "the feature prefilter's window radius in pixels (0: off)",
             ),
             ParamSpec::new(
@@ -376,6 +391,12 @@ pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
                 "256",
                 "rows filtered at a time, each band with a halo of the windows' reach: less \
                  memory, more time; the image is the same (0: the whole image at once)",
+            ),
+            ParamSpec::new(
+                "stride",
+                ParamType::Integer,
+                "2",
+                "the regressions fit every stride-th pixel in each direction (1: every pixel)",
             ),
             ParamSpec::new(
                 "ridge",
@@ -399,7 +420,8 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
             float_in(p, "ridge", RIDGE, 0.0..=1e3)?,
         )
         .with_second_pass(p.bool_or("secondpass", true)?)
-        .with_band(int_in(p, "band", BAND as i32, 0..=1 << 16)?),
+        .with_band(int_in(p, "band", BAND as i32, 0..=1 << 16)?)
+        .with_stride(int_in(p, "stride", STRIDE as i32, 1..=4)? as u32),
     ))
 }
 

@@ -150,16 +150,30 @@ fn box_row(src: &[f32], dst: &mut [f32], off: usize, r: usize) {
     let x0 = off;
     let (a0, b0) = (x0.saturating_sub(r), (x0 + r + 1).min(n));
     let mut sum: f32 = src[a0..b0].iter().sum();
+    // The running sums first, then the divisions by the counts (a loop apart, so that they
+    // go in vector lanes).
     for (i, d) in dst.iter_mut().enumerate() {
         let x = x0 + i;
-        let (a, b) = (x.saturating_sub(r), (x + r + 1).min(n));
-        *d = sum / (b - a) as f32;
+        *d = sum;
         if x + r + 1 < n {
             sum += src[x + r + 1];
         }
         if x >= r {
             sum -= src[x - r];
         }
+    }
+    // Columns whose window lies inside the row have the full count.
+    let full = (2 * r + 1) as f32;
+    let lo = r.saturating_sub(x0).min(dst.len());
+    let hi = (n.saturating_sub(r + x0)).clamp(lo, dst.len());
+    for (i, d) in dst.iter_mut().enumerate() {
+        if i < lo || i >= hi {
+            let x = x0 + i;
+            *d /= ((x + r + 1).min(n) - x.saturating_sub(r)) as f32;
+        }
+    }
+    for d in &mut dst[lo..hi] {
+        *d /= full;
     }
 }
 
@@ -183,6 +197,23 @@ pub(crate) fn weight(d: f32) -> f32 {
 /// `radius`, weighted by the patch distances of `guide`. Pixels whose `group` differs (a
 /// surface against an emitter or the background) never mix.
 pub(crate) fn nl_means(image: &Planes, guide: Guide<'_>, radius: usize, group: &[bool]) -> Planes {
+    match image.c {
+        1 => nl_means_c::<1>(image, guide, radius, group),
+        3 => nl_means_c::<3>(image, guide, radius, group),
+        7 => nl_means_c::<7>(image, guide, radius, group),
+        _ => nl_means_c::<0>(image, guide, radius, group),
+    }
+}
+
+/// `nl_means` for `C` channels (0: whatever `image` has). Per offset and row of the tile,
+/// the weights of the columns whose neighbour is inside are made first (zero where the
+/// groups differ: such a neighbour is skipped), then added in.
+fn nl_means_c<const C: usize>(
+    image: &Planes,
+    guide: Guide<'_>,
+    radius: usize,
+    group: &[bool],
+) -> Planes {
     let (w, h, c) = (image.w, image.h, image.c);
     let r = radius as i64;
     by_tiles(w, h, c, |rect| {
@@ -191,23 +222,41 @@ pub(crate) fn nl_means(image: &Planes, guide: Guide<'_>, radius: usize, group: &
         let mut acc = vec![0.0f32; rect.len() * c];
         let mut wsum = vec![0.0f32; rect.len()];
         let rw = rect.w();
+        let mut wts = vec![0.0f32; rw];
         for dy in -r..=r {
             for dx in -r..=r {
                 guide.patch_distances((dx, dy), rect, &mut scratch, &mut dist);
-                for (j, &d) in dist.iter().enumerate() {
-                    if d == f32::INFINITY {
+                // The columns whose neighbour is inside the image (the distance elsewhere
+                // is infinite).
+                let xa = (rect.x0 as i64).max(-dx);
+                let xb = (rect.x1 as i64).min(w as i64 - dx);
+                if xa >= xb {
+                    continue;
+                }
+                let (ja, n) = ((xa - rect.x0 as i64) as usize, (xb - xa) as usize);
+                for (jr, y) in (rect.y0..rect.y1).enumerate() {
+                    let qy = y as i64 + dy;
+                    if qy < 0 || qy >= h as i64 {
                         continue;
                     }
-                    let p = (rect.y0 + j / rw) * w + rect.x0 + j % rw;
-                    let q = (p as i64 + dy * w as i64 + dx) as usize;
-                    if group[p] != group[q] {
-                        continue;
+                    let p0 = y * w + xa as usize;
+                    let q0 = (qy * w as i64 + xa + dx) as usize;
+                    let j0 = jr * rw + ja;
+                    let (gp, gq) = (&group[p0..p0 + n], &group[q0..q0 + n]);
+                    let wts = &mut wts[..n];
+                    for (i, (o, d)) in wts.iter_mut().zip(&dist[j0..j0 + n]).enumerate() {
+                        let v = weight(*d);
+                        *o = if gp[i] == gq[i] { v } else { 0.0 };
                     }
-                    let wt = weight(d);
-                    wsum[j] += wt;
-                    let (src, dst) = (image.px(q), &mut acc[j * c..(j + 1) * c]);
-                    for (o, s) in dst.iter_mut().zip(src) {
-                        *o += wt * s;
+                    for (s, &wt) in wsum[j0..j0 + n].iter_mut().zip(wts.iter()) {
+                        *s += wt;
+                    }
+                    let src = &image.data[q0 * c..(q0 + n) * c];
+                    let dst = &mut acc[j0 * c..(j0 + n) * c];
+                    if C == 0 {
+                        add_weighted(dst, src, wts, c);
+                    } else {
+                        add_weighted(dst, src, wts, C);
                     }
                 }
             }
@@ -220,6 +269,19 @@ pub(crate) fn nl_means(image: &Planes, guide: Guide<'_>, radius: usize, group: &
         }
         acc
     })
+}
+
+/// Adds each pixel of `src` (`c` channels) times its weight to `dst`; zero weights add
+/// nothing.
+#[inline(always)]
+fn add_weighted(dst: &mut [f32], src: &[f32], wts: &[f32], c: usize) {
+    for ((d, s), &wt) in dst.chunks_exact_mut(c).zip(src.chunks_exact(c)).zip(wts) {
+        if wt != 0.0 {
+            for ch in 0..c {
+                d[ch] += wt * s[ch];
+            }
+        }
+    }
 }
 
 #[cfg(test)]
