@@ -383,6 +383,28 @@ const PBRT_V3_FEATURES: &[(&str, &str, u32)] = &[
     ("media-fog-spot.pbrt", "media-fog-spot", 16),
 ];
 
+/// acr's render of `desc` at `spp` (seed 11) against the references of `scenes/pbrt-v3/`:
+/// its MSE (8-bit sRGB) against pbrt-v3's converged `{stem}-ref1024.exr`, pbrt-v3's own at
+/// that spp (`{stem}-{pbrt}.exr`), and acr's image mean over the reference's.
+fn against_pbrt_v3(desc: &SceneDescription, spp: u32, stem: &str, pbrt: &str) -> (f64, f64, f64) {
+    let dir = root().join("scenes/pbrt-v3/references");
+    let r = render_desc(desc, spp, 11);
+    let read = |name: String| {
+        acr::image_io::read_image(&dir.join(name), false)
+            .unwrap()
+            .pixels
+    };
+    let reference = read(format!("{stem}-ref1024.exr"));
+    let pbrt = read(format!("{stem}-{pbrt}.exr"));
+    assert_eq!(reference.len(), r.pixels.len(), "{stem}");
+    let lum = |p: &[Spectrum]| f64::from(acr::spectrum_luminance(mean(p)));
+    (
+        srgb8_mse(&r.pixels, &reference),
+        srgb8_mse(&pbrt, &reference),
+        lum(&r.pixels) / lum(&reference),
+    )
+}
+
 /// At the scene's spp, acr's MSE against pbrt-v3's converged render is within 1.25x pbrt-v3's
 /// own at that spp, and the image means agree within 1%: the rule of
 /// [`agrees_with_pbrt_v3_references`], on scenes and references that ship with acr.
@@ -392,21 +414,7 @@ fn new_features_agree_with_pbrt_v3() {
     let mut failures = Vec::new();
     for &(scene, stem, spp) in PBRT_V3_FEATURES {
         let desc = parse_file(&dir.join(scene)).unwrap();
-        let r = render_desc(&desc, spp, 11);
-        let read = |name: String| {
-            acr::image_io::read_image(&dir.join("references").join(name), false)
-                .unwrap()
-                .pixels
-        };
-        let reference = read(format!("{stem}-ref1024.exr"));
-        let pbrt = read(format!("{stem}-pbrt{spp}.exr"));
-        assert_eq!(reference.len(), r.pixels.len(), "{scene}");
-        let (mse, pbrt_mse) = (
-            srgb8_mse(&r.pixels, &reference),
-            srgb8_mse(&pbrt, &reference),
-        );
-        let lum = |p: &[Spectrum]| f64::from(acr::spectrum_luminance(mean(p)));
-        let ratio = lum(&r.pixels) / lum(&reference);
+        let (mse, pbrt_mse, ratio) = against_pbrt_v3(&desc, spp, stem, &format!("pbrt{spp}"));
         eprintln!(
             "{scene}: acr MSE {mse:.3e}, pbrt-v3 {pbrt_mse:.3e} (ratio {:.2}); mean {ratio:.4}",
             mse / pbrt_mse
@@ -430,20 +438,7 @@ fn volpath_renders_subsurface_materials() {
     for stem in ["subsurface", "kdsubsurface"] {
         let mut desc = parse_file(&dir.join(format!("{stem}.pbrt"))).unwrap();
         desc.integrator.as_mut().unwrap().kind = "volpath".into();
-        let r = render_desc(&desc, 16, 11);
-        let read = |name: String| {
-            acr::image_io::read_image(&dir.join("references").join(name), false)
-                .unwrap()
-                .pixels
-        };
-        let reference = read(format!("{stem}-ref1024.exr"));
-        let pbrt = read(format!("{stem}-volpath-pbrt16.exr"));
-        let (mse, pbrt_mse) = (
-            srgb8_mse(&r.pixels, &reference),
-            srgb8_mse(&pbrt, &reference),
-        );
-        let lum = |p: &[Spectrum]| f64::from(acr::spectrum_luminance(mean(p)));
-        let ratio = lum(&r.pixels) / lum(&reference);
+        let (mse, pbrt_mse, ratio) = against_pbrt_v3(&desc, 16, stem, "volpath-pbrt16");
         eprintln!(
             "{stem} (volpath): MSE ratio {:.2}, mean {ratio:.4}",
             mse / pbrt_mse

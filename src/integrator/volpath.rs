@@ -172,6 +172,28 @@ fn media_at(surface: &Surface, medium: Option<u32>) -> MediumInterface {
     })
 }
 
+/// At a surface vertex: one light sampled (when `light`: the BSDF has a non-specular part),
+/// then the direction that continues the path. Adds the light to `l` and multiplies `beta` by
+/// f / pdf (`step` holds beta, l and the rays traced); `None` ends the path.
+fn continue_from(
+    scene: &Scene,
+    v: &Vertex,
+    light: bool,
+    strategy: LightStrategy,
+    stream: &mut SampleStream,
+    (beta, l, rays): (&mut Spectrum, &mut Spectrum, &mut u32),
+) -> Option<Scattered> {
+    if light {
+        *l += *beta * sample_one_light(scene, v, strategy, stream, rays);
+    }
+    let s = v.sample(stream)?;
+    if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
+        return None;
+    }
+    *beta *= s.f / s.pdf;
+    Some(s)
+}
+
 /// A ray's closest hit before its interaction is computed (which a path that scatters in a
 /// medium first, or a shadow ray that is blocked, never needs).
 #[derive(Clone, Copy)]
@@ -467,16 +489,12 @@ pub(super) fn volpath_li(
                 bsdf: &bsdf,
                 media,
             };
-            if bsdf.has_non_specular() {
-                l += beta * sample_one_light(scene, &v, settings.light_strategy, stream, &mut rays);
-            }
-            let Some(s) = v.sample(stream) else {
+            let light = bsdf.has_non_specular();
+            let strategy = settings.light_strategy;
+            let step = (&mut beta, &mut l, &mut rays);
+            let Some(s) = continue_from(scene, &v, light, strategy, stream, step) else {
                 break;
             };
-            if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
-                break;
-            }
-            beta *= s.f / s.pdf;
             specular_bounce = s.specular;
             let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
             if s.specular && transmitted {
@@ -510,14 +528,10 @@ pub(super) fn volpath_li(
                     bsdf: &adapter,
                     media: scene.surfaces[exit.surface as usize].media.unwrap_or(media),
                 };
-                l += beta * sample_one_light(scene, &v, settings.light_strategy, stream, &mut rays);
-                let Some(s) = v.sample(stream) else {
+                let step = (&mut beta, &mut l, &mut rays);
+                let Some(s) = continue_from(scene, &v, true, strategy, stream, step) else {
                     break;
                 };
-                if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
-                    break;
-                }
-                beta *= s.f / s.pdf;
                 specular_bounce = s.specular;
                 mr = v.spawn(s.wi);
             }
