@@ -73,6 +73,22 @@ pub struct Radiance {
 /// Builds an integrator from its checked parameters.
 pub type IntegratorBuild = fn(&Choice) -> Result<Integrator>;
 
+/// `path`'s and `volpath`'s Russian roulette threshold.
+const RR_THRESHOLD: ParamSpec = ParamSpec::new(
+    "rrthreshold",
+    ParamType::Float,
+    "1",
+    "Russian roulette once the throughput's largest channel is below this",
+);
+
+/// `path`'s and `volpath`'s light choice.
+const LIGHT_SAMPLE_STRATEGY: ParamSpec = ParamSpec::new(
+    "lightsamplestrategy",
+    ParamType::String,
+    "bvh",
+    "how a light is chosen: bvh (pbrt-v4's light BVH), spatial (pbrt-v3's default), power or uniform",
+);
+
 /// Every integrator, by name.
 pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
     Entry {
@@ -87,18 +103,8 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
                     "5",
                     "longest path, in bounces",
                 ),
-                ParamSpec::new(
-                    "rrthreshold",
-                    ParamType::Float,
-                    "1",
-                    "Russian roulette once the throughput's largest channel is below this",
-                ),
-                ParamSpec::new(
-                    "lightsamplestrategy",
-                    ParamType::String,
-                    "bvh",
-                    "how a light is chosen: bvh (pbrt-v4's light BVH), spatial (pbrt-v3's default), power or uniform",
-                ),
+                RR_THRESHOLD,
+                LIGHT_SAMPLE_STRATEGY,
             ],
         },
         build: Integrator::path,
@@ -115,18 +121,8 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
                     "5",
                     "longest path, in scattering events (surface or medium)",
                 ),
-                ParamSpec::new(
-                    "rrthreshold",
-                    ParamType::Float,
-                    "1",
-                    "Russian roulette once the throughput's largest channel is below this",
-                ),
-                ParamSpec::new(
-                    "lightsamplestrategy",
-                    ParamType::String,
-                    "bvh",
-                    "how a light is chosen: bvh (pbrt-v4's light BVH), spatial (pbrt-v3's default), power or uniform",
-                ),
+                RR_THRESHOLD,
+                LIGHT_SAMPLE_STRATEGY,
             ],
         },
         build: Integrator::volpath,
