@@ -16,25 +16,27 @@ fn parse(text: &str) -> SceneDescription {
 /// The scene's warnings (parse, build and plugin choice) and its image at `spp`, with the
 /// count of dropped samples.
 fn render_text(text: &str, spp: u32) -> (Vec<Warning>, Vec<Spectrum>, u64) {
-    let desc = parse(text);
+    render_desc(&parse(text), &Overrides::default(), spp, 3)
+}
+
+/// [`render_text`] of a parsed scene, with the command line's `overrides`, at `seed`.
+fn render_desc(
+    desc: &SceneDescription,
+    overrides: &Overrides,
+    spp: u32,
+    seed: u64,
+) -> (Vec<Warning>, Vec<Spectrum>, u64) {
     let mut warnings = desc.warnings.clone();
-    let scene = Scene::build(&desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut plugins = choose_for_scene(
-        &desc,
-        &scene,
-        &Overrides::default(),
-        Some(spp),
-        3,
-        &mut warnings,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+    let mut plugins = choose_for_scene(desc, &scene, overrides, Some(spp), seed, &mut warnings)
+        .unwrap_or_else(|e| panic!("{e}"));
     let mut film = plugins.film(&scene);
     let counts = render(
         &scene,
         &plugins.integrator,
         plugins.sampler.as_mut(),
         &mut film,
-        3,
+        seed,
         None,
         None,
     );
@@ -269,8 +271,6 @@ fn adaptive_samplers_keep_the_mean_of_a_medium_scene() {
         .join("scenes/pbrt-v3/media-homogeneous.pbrt");
     let desc = acr::parser::parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
     let image_mean = |sampler: &str, settings: &[&str], spp: u32| {
-        let mut warnings = Vec::new();
-        let scene = Scene::build(&desc, &mut warnings).unwrap();
         let overrides = Overrides {
             sampler: Some(sampler.into()),
             filter: None,
@@ -280,19 +280,8 @@ fn adaptive_samplers_keep_the_mean_of_a_medium_scene() {
                 .map(|s| Setting::parse(s).unwrap())
                 .collect(),
         };
-        let mut plugins =
-            choose_for_scene(&desc, &scene, &overrides, Some(spp), 1, &mut warnings).unwrap();
-        let mut film = plugins.film(&scene);
-        render(
-            &scene,
-            &plugins.integrator,
-            plugins.sampler.as_mut(),
-            &mut film,
-            1,
-            None,
-            None,
-        );
-        let m = mean(&plugins.image(&film));
+        let (_, image, _) = render_desc(&desc, &overrides, spp, 1);
+        let m = mean(&image);
         f64::from(m.x + m.y + m.z) / 3.0
     };
     let reference = image_mean("stratified", &[], 64);
