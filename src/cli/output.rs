@@ -110,13 +110,12 @@ impl Output {
     /// The image so far, mid-render: a mergeable EXR of the passes done when the sums can be
     /// merged (samplesPerPixel: the fewest samples any pixel has), else the splatted image.
     pub fn write_partial(&self, film: &Film, seconds: f64) -> Result<(), String> {
+        let spp = reached_spp(&film.pixel_stats());
         if self.can_merge {
-            let spp = reached_spp(&film.pixel_stats());
             let sums = self.sums(film, spp, seconds)?;
             return self.atomically(|temp| sums.write(temp));
         }
         let image: Vec<Spectrum> = film.pixels().into_iter().map(|c| c * self.scale).collect();
-        let spp = reached_spp(&film.pixel_stats());
         self.write_image(&image, Vec::new(), spp)
     }
 
@@ -130,21 +129,19 @@ impl Output {
     /// mergeable when asked or when the render was stopped by a signal and can be merged.
     /// `spp` is what each pixel was planned to get; a halted render records what it reached.
     pub fn write_final(&self, image: &[Spectrum], film: &Film, end: &End) -> Result<(), String> {
+        // Computed once: with half buffers every call makes the whole image's statistics.
+        let stats = film.pixel_stats();
         let mut aovs = Vec::new();
         for name in &self.channel_aovs {
-            aovs.extend(channel_values(
-                name,
-                &film.pixel_stats(),
-                self.scale,
-                end.features,
-            )?);
+            aovs.extend(channel_values(name, &stats, self.scale, end.features)?);
         }
+        let spp = if end.halted {
+            reached_spp(&stats)
+        } else {
+            end.spp
+        };
+        drop(stats);
         if self.writes_sums(end.signalled) {
-            let spp = if end.halted {
-                reached_spp(&film.pixel_stats())
-            } else {
-                end.spp
-            };
             let mut sums = self.sums(film, spp, end.seconds)?;
             // What the sums already hold is not written twice.
             aovs.retain(|(n, _)| {
@@ -156,11 +153,6 @@ impl Output {
             sums.aovs = aovs;
             return self.atomically(|temp| sums.write(temp));
         }
-        let spp = if end.halted {
-            reached_spp(&film.pixel_stats())
-        } else {
-            end.spp
-        };
         self.write_image(image, aovs, spp)
     }
 
