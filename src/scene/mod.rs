@@ -89,7 +89,7 @@ impl Scene {
 }
 
 /// Whether the scene has a texture class or a bump map that reads the ray differentials.
-fn uses_differentials(desc: &SceneDescription) -> bool {
+pub fn uses_differentials(desc: &SceneDescription) -> bool {
     let footprint = [
         "imagemap",
         "checkerboard",

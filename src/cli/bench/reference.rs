@@ -54,10 +54,10 @@ fn reference_key(
         env!("CARGO_PKG_VERSION")
     );
     fnv1a(&mut h, m.as_bytes());
-    // A textured scene's reference filters its textures for the reference's own budget
+    // A scene whose textures read the footprint filters them for the reference's own budget
     // (docs/pbrt-v3-compatibility.md, "Ray differentials"): references cached before that
-    // rule used the scene's own spp and must not be read back. Untextured keys are unchanged.
-    if !desc.textures.is_empty() {
+    // rule used the scene's own spp and must not be read back. Other keys are unchanged.
+    if crate::scene::uses_differentials(&desc) {
         fnv1a(&mut h, format!("|footprint spp {spp}").as_bytes());
     }
     // Uncropped keys stay those of before, so that cached references remain valid.
@@ -126,7 +126,7 @@ mod tests {
     use super::*;
 
     /// Keys of references cached before the footprint rule: an untextured scene's key is the
-    /// same as then, a textured one's is not.
+    /// same as then, one whose textures read the footprint is not.
     #[test]
     fn only_textured_keys_carry_the_footprint() {
         let dir = std::env::temp_dir().join(format!("acr-refkey-{}", std::process::id()));
