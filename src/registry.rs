@@ -73,7 +73,8 @@ impl Plugins {
     }
 
     /// The image from `film`: the filter's reconstruction, with the sampler's partition when it
-    /// has one, times the film's `scale`; row-major over the cropped film.
+    /// has one, plus the film's unfiltered splats, times the film's `scale`; row-major over the
+    /// cropped film.
     pub fn image(&self, film: &Film) -> Vec<Spectrum> {
         let scale = film.settings().scale;
         let filtered = |film: &Film| {
@@ -86,16 +87,15 @@ impl Plugins {
             )
         };
         // Two streams: each reconstructed alone, the image their mean; a filter that reads the
-        // half buffers has both streams there.
-        self.sampler
-            .reconstruct(film)
-            .unwrap_or_else(|| {
-                if self.filter.reads_pixel_buffers() {
-                    filtered(film)
-                } else {
-                    film.per_stream(|f, _| filtered(f))
-                }
-            })
+        // half buffers has both streams there. Unfiltered splats are added after.
+        let reconstructed = self.sampler.reconstruct(film).unwrap_or_else(|| {
+            if self.filter.reads_pixel_buffers() {
+                filtered(film)
+            } else {
+                film.per_stream(|f, _| filtered(f))
+            }
+        });
+        film.with_splats(reconstructed)
             .into_iter()
             .map(|c| c * scale)
             .collect()

@@ -115,7 +115,11 @@ impl Output {
             let sums = self.sums(film, spp, seconds)?;
             return self.atomically(|temp| sums.write(temp));
         }
-        let image: Vec<Spectrum> = film.pixels().into_iter().map(|c| c * self.scale).collect();
+        let image: Vec<Spectrum> = film
+            .with_splats(film.pixels())
+            .into_iter()
+            .map(|c| c * self.scale)
+            .collect();
         self.write_image(&image, Vec::new(), spp)
     }
 

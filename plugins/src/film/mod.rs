@@ -17,12 +17,14 @@ pub use buffers::{HalfPixel, PixelBuffers};
 pub use settings::{FilmSettings, MAX_PIXELS, MAX_RESOLUTION};
 use splat::{Prepared, Splat, TABLE_SIZE};
 pub use stats::{relative_error_of, PixelStats};
+pub use unfiltered::UnfilteredSplats;
 
 mod buffers;
 mod half_float;
 mod settings;
 mod splat;
 mod stats;
+mod unfiltered;
 
 /// Accumulated, filtered samples.
 #[derive(Clone, Debug)]
@@ -45,6 +47,8 @@ pub struct Film {
     first_weight: f64,
     /// Per-pixel half buffers, for a filter that reads them ([`Film::keep_pixel_buffers`]).
     buffers: Option<Box<PixelBuffers>>,
+    /// Unfiltered splats (light tracing, mlt, sppm), added to the reconstructed image.
+    unfiltered: UnfilteredSplats,
 }
 
 impl Film {
@@ -76,7 +80,39 @@ impl Film {
             halves: None,
             first_weight: 0.5,
             buffers: None,
+            unfiltered: UnfilteredSplats::default(),
         }
+    }
+
+    /// Adds unfiltered splats, each to the one pixel holding its raster position (pbrt-v3's
+    /// `Film::AddSplat`); those outside the crop are dropped, those not finite or negative
+    /// dropped and counted. In the order given, so the sums do not depend on thread count.
+    pub fn add_splats(&mut self, splats: &[(Vec2, Spectrum)]) {
+        let crop = self.settings.crop;
+        let (w, h) = self.settings.size();
+        let pixels = w as usize * h as usize;
+        for &(p, l) in splats {
+            if let Some(i) = unfiltered::splat_index(crop, p) {
+                self.unfiltered.add(pixels, i, l);
+            }
+        }
+    }
+
+    /// The unfiltered splats: their sums and scale.
+    pub fn unfiltered(&self) -> &UnfilteredSplats {
+        &self.unfiltered
+    }
+
+    /// The unfiltered splats, to set their scale or merge sums into them.
+    pub fn unfiltered_mut(&mut self) -> &mut UnfilteredSplats {
+        &mut self.unfiltered
+    }
+
+    /// `image` (a reconstruction of this film, row-major over the crop, before the film's
+    /// `scale`) with the unfiltered splats added.
+    pub fn with_splats(&self, mut image: Vec<Spectrum>) -> Vec<Spectrum> {
+        self.unfiltered.add_to(&mut image);
+        image
     }
 
     /// Makes the film keep each pixel's two halves of samples (by index parity) with their

@@ -255,3 +255,24 @@ fn a_film_with_half_buffers_reads_everything_from_them() {
     assert!(halves.pixel_buffers().is_none());
     assert_eq!(halves.pixel_stats(), &before[..]);
 }
+
+#[test]
+fn unfiltered_splats_land_in_their_pixel_scaled_and_crop_drops_the_rest() {
+    let mut settings = FilmSettings::with_resolution(4, 4);
+    settings.set_pixel_bounds([1, 3, 1, 3]).unwrap();
+    let mut f = Film::new(settings, &BoxFilter::new(0.5, 0.5));
+    f.add_splats(&[
+        (Vec2::new(1.5, 2.2), Spectrum::splat(2.0)),
+        (Vec2::new(1.9, 2.9), Spectrum::splat(1.0)),
+        // Outside the crop, and not finite: neither lands.
+        (Vec2::new(0.5, 0.5), Spectrum::splat(5.0)),
+        (Vec2::new(2.5, 1.5), Spectrum::splat(f32::NAN)),
+    ]);
+    assert_eq!(f.unfiltered().dropped, 1);
+    f.unfiltered_mut().set_scale(0.5);
+    let image = f.with_splats(vec![Spectrum::ZERO; 4]);
+    // Crop row 1 (raster y 2), column 0 (raster x 1): (2 + 1) * 0.5.
+    assert_eq!(image[2], Spectrum::splat(1.5));
+    assert_eq!(image[0], Spectrum::ZERO);
+    assert_eq!(image[1], Spectrum::ZERO);
+}

@@ -128,7 +128,7 @@ impl Looks<'_> {
             let scale = film.settings().scale;
             d.show(
                 &film
-                    .pixels()
+                    .with_splats(film.pixels())
                     .into_iter()
                     .map(|c| c * scale)
                     .collect::<Vec<_>>(),
