@@ -138,6 +138,31 @@ impl SampleStream {
     }
 }
 
+/// Where an estimator draws its random decisions: a pixel sample's [`SampleStream`], or a
+/// sampler that drives its own (mlt's primary sample space). Estimators shared by both (bdpt's
+/// subpaths) are generic over it.
+pub trait SampleSource {
+    /// The next value in [0, 1).
+    fn next_1d(&mut self) -> f32;
+    /// The next pair of values in [0, 1)^2.
+    fn next_2d(&mut self) -> glam::Vec2 {
+        let u = self.next_1d();
+        glam::Vec2::new(u, self.next_1d())
+    }
+}
+
+impl SampleSource for SampleStream {
+    #[inline(always)]
+    fn next_1d(&mut self) -> f32 {
+        SampleStream::next_1d(self)
+    }
+
+    #[inline(always)]
+    fn next_2d(&mut self) -> glam::Vec2 {
+        SampleStream::next_2d(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
