@@ -15,12 +15,14 @@ use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::sampling::power_heuristic;
 use crate::scene::Scene;
-use crate::stream::SampleStream;
+use crate::stream::{SampleSource, SampleStream};
 use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
+pub mod mlt;
 mod subsurface;
 mod volpath;
+pub use mlt::MltSettings;
 pub use volpath::VolPathSettings;
 
 /// Most consecutive pass-through surfaces (`Material ""`) a ray may cross before it is
@@ -50,6 +52,8 @@ pub enum Integrator {
     },
     /// `volpath`: path tracing through participating media (docs/media.md).
     VolPath(VolPathSettings),
+    /// `mlt`: primary-sample-space Metropolis light transport (docs/light-transport.md).
+    Mlt(MltSettings),
     /// `directlighting`.
     Direct {
         /// Specular recursion depth.
@@ -149,6 +153,7 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
         },
         build: Integrator::direct,
     },
+    mlt::ENTRY,
 ];
 
 /// `maxdepth`, which must not be negative.
@@ -221,6 +226,7 @@ impl Integrator {
         match self {
             Integrator::Path { .. } => "path",
             Integrator::VolPath(_) => "volpath",
+            Integrator::Mlt(_) => "mlt",
             Integrator::Direct { .. } => "directlighting",
         }
     }
@@ -244,9 +250,26 @@ impl Integrator {
                 ray,
                 diff,
                 stream,
-                max_depth,
-                rr_threshold,
+                PathRange {
+                    min_depth: 0,
+                    max_depth,
+                    rr_threshold,
+                },
                 light_strategy,
+            ),
+            // mlt renders through `mlt::render`; a caller tracing pixel samples with it gets
+            // path's estimate of the same depth.
+            Integrator::Mlt(ref m) => path_li(
+                scene,
+                ray,
+                diff,
+                stream,
+                PathRange {
+                    min_depth: 0,
+                    max_depth: m.max_depth,
+                    rr_threshold: 1.0,
+                },
+                LightStrategy::Bvh,
             ),
             Integrator::VolPath(settings) => {
                 volpath::volpath_li(scene, ray, diff, stream, settings)
@@ -276,7 +299,7 @@ fn sample_light(
     bsdf: &crate::bsdf::Bsdf,
     light_index: u32,
     choice_pdf: f32,
-    stream: &mut SampleStream,
+    stream: &mut impl SampleSource,
     rays: &mut u32,
 ) -> Spectrum {
     let light = &scene.lights[light_index as usize];
@@ -351,7 +374,7 @@ fn next_event(
     bsdf: &crate::bsdf::Bsdf,
     ctx: LightContext,
     strategy: LightStrategy,
-    stream: &mut SampleStream,
+    stream: &mut impl SampleSource,
     rays: &mut u32,
 ) -> Option<Spectrum> {
     match scene.choose_light(strategy, ctx, stream.next_1d()) {
@@ -371,17 +394,35 @@ fn next_event(
     }
 }
 
+/// Which path lengths `path_li` counts, in scattering vertices (0: emission the camera ray
+/// finds; a light sample at the first hit makes a path of length 1), and how it ends.
+#[derive(Clone, Copy)]
+struct PathRange {
+    /// Contributions of shorter paths are traced past but not added.
+    min_depth: u32,
+    /// Longest path, in bounces.
+    max_depth: u32,
+    /// Russian roulette below this throughput (0: never).
+    rr_threshold: f32,
+}
+
 /// The path integrator's estimate of the radiance along `ray`: at each scattering a light
 /// sample and a BSDF sample, emission found weighted by MIS, Russian roulette after depth 3.
+/// Only contributions of lengths in `range` are added (`path` counts from 0; mlt asks for
+/// one length at a time, see [`path_of_depth`]).
 fn path_li(
     scene: &Scene,
     mut ray: Ray,
     mut diff: Option<&RayDifferentials>,
-    stream: &mut SampleStream,
-    max_depth: u32,
-    rr_threshold: f32,
+    stream: &mut impl SampleSource,
+    range: PathRange,
     light_strategy: LightStrategy,
 ) -> Radiance {
+    let PathRange {
+        min_depth,
+        max_depth,
+        rr_threshold,
+    } = range;
     let mut l = Spectrum::ZERO;
     let mut beta = Spectrum::ONE;
     let mut rays = 0u32;
@@ -399,6 +440,9 @@ fn path_li(
     loop {
         rays += 1;
         let Some(hit) = scene.intersect(&ray) else {
+            if depth < min_depth {
+                break;
+            }
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
@@ -415,7 +459,7 @@ fn path_li(
             si.compute_differentials(d);
         }
         probe.travel(ray.o, si.p);
-        if let Some(li) = hit.surface.area_light {
+        if let Some(li) = hit.surface.area_light.filter(|_| depth >= min_depth) {
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
             if le != Spectrum::ZERO {
@@ -448,9 +492,14 @@ fn path_li(
                 n: si.shading_n,
             };
             last.ctx = Some(ctx);
-            let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
-            if let Some(direct) = direct {
-                l += beta * direct;
+            // A light sample here makes a path one longer than this one; a shorter one than
+            // asked for is not traced.
+            if depth + 1 >= min_depth {
+                let direct =
+                    next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
+                if let Some(direct) = direct {
+                    l += beta * direct;
+                }
             }
         }
         let u_lobe = stream.next_1d();
@@ -480,6 +529,8 @@ fn path_li(
         ray = si.spawn_ray(s.wi);
         // Transmitted into a subsurface material: the path leaves from an exit point instead.
         if let Some(bssrdf) = transmitted.then(|| material.bssrdf(&si)).flatten() {
+            // The light sampled at the exit point counts as a path one longer than this one.
+            let mut at_exit = Spectrum::ZERO;
             let exit = subsurface::scatter(
                 scene,
                 &bssrdf,
@@ -488,10 +539,13 @@ fn path_li(
                 light_strategy,
                 stream,
                 &mut beta,
-                &mut l,
+                &mut at_exit,
                 &mut last,
                 &mut rays,
             );
+            if depth + 1 >= min_depth {
+                l += at_exit;
+            }
             let Some(next) = exit else { break };
             ray = next;
         }
@@ -511,6 +565,26 @@ fn path_li(
         rays,
         first_hit: probe.features(),
     }
+}
+
+/// The part of `path`'s estimate along the camera ray `ray` made by paths of exactly `depth`
+/// scattering vertices, without Russian roulette: summed over depths 0 to `max_depth` it is
+/// `path`'s estimate with that `maxdepth` (without roulette). What mlt's interim path
+/// contribution traces (docs/light-transport.md, `## mlt`).
+pub(crate) fn path_of_depth(
+    scene: &Scene,
+    ray: Ray,
+    diff: Option<&RayDifferentials>,
+    stream: &mut impl SampleSource,
+    depth: u32,
+    light_strategy: LightStrategy,
+) -> Radiance {
+    let range = PathRange {
+        min_depth: depth,
+        max_depth: depth,
+        rr_threshold: 0.0,
+    };
+    path_li(scene, ray, diff, stream, range, light_strategy)
 }
 
 /// What a recursive estimate counts on its way: rays traced and the first-hit features.

@@ -154,6 +154,29 @@ fn media_warning(desc: &SceneDescription, integrator: &Integrator, warnings: &mu
     warnings.push(Warning::at(loc, message));
 }
 
+/// mlt makes its own samples (its Markov chains): a sampler that adapts to what it traced, or
+/// reconstructs the image itself, would have nothing to work on, so naming one is an error.
+fn refuse_adaptive_with_mlt(
+    integrator: &Integrator,
+    sampler: &dyn Sampler,
+    choice: &Choice,
+) -> Result<()> {
+    let plain = ["random", "stratified", "halton", "sobol"];
+    if !matches!(integrator, Integrator::Mlt(_)) || plain.contains(&sampler.name()) {
+        return Ok(());
+    }
+    let message = format!(
+        "the mlt integrator drives its own sampling (Markov chains in primary sample space); \
+         the adaptive sampler \"{}\" cannot be used with it (use halton, sobol, stratified or \
+         random, whose --spp sets mlt's mutations per pixel)",
+        sampler.name()
+    );
+    Err(match &choice.loc {
+        Some(loc) => acr_parser::Error::at(loc, message),
+        None => acr_parser::Error::file("--sampler", message),
+    })
+}
+
 /// Chooses and builds the sampler, filter and integrator: the scene's directives, with the
 /// command line's names and settings on top. Without a directive, pbrt-v3's defaults: the
 /// `halton` sampler at 16 spp, the `box` filter and the `path` integrator. The sampler's
@@ -172,8 +195,14 @@ pub fn choose(
     media_alias(desc, &mut ic, warnings);
     let ie: &Entry<IntegratorBuild> =
         resolve(INTEGRATORS, Kind::Integrator, &mut ic, overrides, warnings)?;
-    let integrator = (ie.build)(&ic)?;
+    let mut integrator = (ie.build)(&ic)?;
     media_warning(desc, &integrator, warnings);
+    if let Integrator::Mlt(m) = &mut integrator {
+        // `--spp` is mlt's mutations per pixel (docs/light-transport.md).
+        if let Some(spp) = setup((0.0, 0.0)).spp {
+            m.mutations_per_pixel = spp.max(1);
+        }
+    }
 
     let mut fc = Choice::new(desc.filter.as_ref(), "box", overrides.filter.as_deref());
     let fe: &Entry<FilterBuild> = resolve(FILTERS, Kind::Filter, &mut fc, overrides, warnings)?;
@@ -191,6 +220,7 @@ pub fn choose(
         ..setup(radius)
     };
     let mut sampler = (se.build)(&sc, &setup((0.0, 0.0)))?;
+    refuse_adaptive_with_mlt(&integrator, sampler.as_ref(), &sc)?;
     if !reads_cells && !sampler.reconstructs() {
         // A splatting filter: sample the crop widened by its radius, so that crops tile the
         // frame. Reconstructions over cells keep to the crop (their cells cover it alone).
@@ -271,9 +301,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, mlt, sppm, \
-         ambientocclusion -> path (bdpt and mlt -> volpath on a scene with media), whitted -> \
-         directlighting.\n",
+         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, sppm, ambientocclusion -> \
+         path (bdpt and mlt -> volpath on a scene with media), whitted -> directlighting.\n",
     );
     out
 }

@@ -227,6 +227,10 @@ pub fn render_with_features(
     progress: Option<&indicatif::ProgressBar>,
     features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
+    // mlt drives its own sampling (docs/light-transport.md).
+    if let Integrator::Mlt(settings) = integrator {
+        return crate::integrator::mlt::render(scene, settings, film, seed, stop, progress);
+    }
     let li = |scene: &Scene,
               ray: Ray,
               diff: Option<&RayDifferentials>,

@@ -103,7 +103,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Sampler, "lowdiscrepancy", "sobol"),
     (Kind::Sampler, "maxmindist", "sobol"),
     (Kind::Integrator, "bdpt", "path"),
-    (Kind::Integrator, "mlt", "path"),
     (Kind::Integrator, "sppm", "path"),
     (Kind::Integrator, "ambientocclusion", "path"),
     (Kind::Integrator, "whitted", "directlighting"),

@@ -11,7 +11,7 @@ use crate::geometry::{is_valid_radiance, Ray, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
-use crate::stream::SampleStream;
+use crate::stream::SampleSource;
 
 /// An exit point found by [`find_exit`]: its interaction (looking out along its shading
 /// normal, pbrt-v3's `Sample_S`) and the index of its surface in the scene.
@@ -31,7 +31,7 @@ pub(super) fn find_exit(
     bssrdf: &TabulatedBssrdf,
     material: u32,
     time: f32,
-    stream: &mut SampleStream,
+    stream: &mut impl SampleSource,
     beta: &mut Spectrum,
     rays: &mut u32,
 ) -> Option<Exit> {
@@ -90,7 +90,7 @@ pub(super) fn scatter(
     material: u32,
     time: f32,
     strategy: LightStrategy,
-    stream: &mut SampleStream,
+    stream: &mut impl SampleSource,
     beta: &mut Spectrum,
     l: &mut Spectrum,
     last: &mut LastScatter,

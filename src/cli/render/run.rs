@@ -9,6 +9,7 @@ use crate::cli::display::Display;
 use crate::cli::output::Output;
 use crate::cli::replay::Recording;
 use crate::first_hit::FeatureImage;
+use crate::integrator::Integrator;
 use crate::render::{render_with_features, Checkpoint, Halt, RenderCounts, Stop};
 use acr_plugins::{Film, SamplePoint, Sampler};
 use std::io::IsTerminal;
@@ -49,6 +50,12 @@ pub(super) fn render_scene(
     let mut film = job.plugins.film(&job.scene);
     let bar = progress_bar(args.quiet);
     let spp = job.plugins.sampler.spp();
+    if args.noise_threshold.is_some() && matches!(job.plugins.integrator, Integrator::Mlt(_)) {
+        return Err("--noise-threshold cannot be used with the mlt integrator: it drives its \
+                    own sampling (Markov chains) and keeps no per-pixel error estimate; use \
+                    --spp (its mutations per pixel) or --time-limit"
+            .to_owned());
+    }
     if let Some(t) = args.noise_threshold {
         // An adaptive sampler that can stops where it is settled; the render loop's global
         // check stops any sampler.

@@ -1,0 +1,110 @@
+//! What mlt's chains sample: a path function of primary sample space, one path length at a
+//! time ([`PathContribution`]), and the function acr uses until bdpt's is plugged in
+//! ([`PathTraced`]): path tracing restricted to one length (docs/light-transport.md, `## mlt`).
+
+use super::sampler::{MltSampler, CAMERA_STREAM};
+use crate::camera::CameraSample;
+use crate::geometry::{Spectrum, Vec2};
+use crate::integrator::path_of_depth;
+use crate::lightdistrib::LightStrategy;
+use acr_plugins::RenderingSpace;
+use crate::scene::Scene;
+use crate::stream::SampleSource;
+
+/// One evaluation of the path function: the radiance it carries to the film and where.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Contribution {
+    /// The contribution (pbrt-v3's `L`'s value, already divided by its sampling density).
+    pub l: Spectrum,
+    /// The raster position it lands on (full-image coordinates).
+    pub raster: Vec2,
+    /// Rays traced for it.
+    pub rays: u32,
+}
+
+/// The function of primary sample space whose paths of one length mlt's chains sample
+/// (pbrt-v3's `MLTIntegrator::L`). Summed over depths 0 to [`PathContribution::max_depth`],
+/// its expectation over the unit hypercube is the image (each pixel's radiance times the
+/// raster area sampled): mlt's bootstrap estimates that total, and the chains its share per
+/// pixel.
+///
+/// pbrt-v3's `L`, the shape the bdpt adapter takes: `start_stream(CAMERA_STREAM)`; for
+/// `depth` 0 the one strategy `s = 0, t = 2` (`n_strategies = 1`), else `n_strategies = depth
+/// + 2` and `s = min(floor(next_1d() * n_strategies), n_strategies - 1)`, `t = n_strategies -
+/// s`; the raster position `space.min + next_2d() * extent`, the time `next_1d()`, the lens
+/// `next_2d()`; `generate_camera_subpath(.., t, ..)` (0 unless it made all `t` vertices);
+/// `start_stream(LIGHT_STREAM)`, `generate_light_subpath(.., s, ..)` (0 unless it made `s`);
+/// `start_stream(CONNECTION_STREAM)`, `connect(.., s, t, ..)` (which may move the raster
+/// position, for `t = 1`), times `n_strategies` (one strategy chosen uniformly of them).
+pub trait PathContribution: Sync {
+    /// The longest path, in scattering vertices (pbrt-v3's `maxdepth`).
+    fn max_depth(&self) -> u32;
+
+    /// The contribution of paths of exactly `depth` scattering vertices at the primary sample
+    /// space point `sampler` holds, over the raster region `space`.
+    fn l(
+        &self,
+        scene: &Scene,
+        space: &RenderingSpace,
+        sampler: &mut MltSampler,
+        depth: u32,
+    ) -> Contribution;
+}
+
+/// The path function until bdpt's lands: a unidirectional path of exactly `depth` bounces
+/// from a camera ray, `path`'s estimator (light samples and BSDF samples combined by MIS)
+/// restricted to that length and without Russian roulette, all its decisions drawn from the
+/// camera stream. PSSMLT over a path tracer, as Kelemen et al.'s.
+#[derive(Clone, Copy, Debug)]
+pub struct PathTraced {
+    /// The longest path, in bounces.
+    pub max_depth: u32,
+    /// How a light is chosen for a light sample.
+    pub light_strategy: LightStrategy,
+}
+
+impl PathContribution for PathTraced {
+    fn max_depth(&self) -> u32 {
+        self.max_depth
+    }
+
+    fn l(
+        &self,
+        scene: &Scene,
+        space: &RenderingSpace,
+        sampler: &mut MltSampler,
+        depth: u32,
+    ) -> Contribution {
+        sampler.start_stream(CAMERA_STREAM);
+        let raster = raster_position(space, sampler.next_2d());
+        let time = sampler.next_1d();
+        let lens = sampler.next_2d();
+        let sample = CameraSample {
+            film: raster,
+            lens,
+            time,
+        };
+        let r = if scene.uses_differentials {
+            let (ray, diff) = scene.camera.generate_ray_differential(&sample);
+            let diff = diff.scaled(&ray, scene.differential_scale);
+            path_of_depth(scene, ray, Some(&diff), sampler, depth, self.light_strategy)
+        } else {
+            let ray = scene.camera.generate_ray(&sample);
+            path_of_depth(scene, ray, None, sampler, depth, self.light_strategy)
+        };
+        Contribution {
+            l: r.l,
+            raster,
+            rays: r.rays,
+        }
+    }
+}
+
+/// The raster position of `u` in [0, 1)^2 over `space`'s pixels, kept inside them (rounding
+/// could carry it onto the far edge).
+pub fn raster_position(space: &RenderingSpace, u: Vec2) -> Vec2 {
+    let lo = Vec2::new(space.x0 as f32, space.y0 as f32);
+    let hi = Vec2::new(space.x1 as f32, space.y1 as f32);
+    let below = |v: f32| f32::from_bits(v.to_bits() - 1);
+    (lo + u * (hi - lo)).min(Vec2::new(below(hi.x), below(hi.y)))
+}

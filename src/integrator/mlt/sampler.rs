@@ -1,0 +1,262 @@
+//! mlt's sampler: pbrt-v3's `MLTSampler`, a point of primary sample space that a Markov chain
+//! mutates (docs/light-transport.md, `## mlt`). Its coordinates are created lazily as the path
+//! asks for them; a large step draws them afresh, a small step moves each by a Gaussian of
+//! width `sigma` (wrapped into [0, 1)), and a rejected proposal restores the ones it moved.
+
+use crate::stream::{mix64, Pcg32, SampleSource};
+
+/// The sample streams pbrt-v3's mlt interleaves: the camera subpath's, the light subpath's
+/// and the connection's decisions, each in coordinates of its own.
+pub const STREAM_COUNT: u32 = 3;
+/// The camera subpath's stream.
+pub const CAMERA_STREAM: u32 = 0;
+/// The light subpath's stream.
+pub const LIGHT_STREAM: u32 = 1;
+/// The connection's stream.
+pub const CONNECTION_STREAM: u32 = 2;
+
+/// One coordinate of primary sample space (pbrt-v3's `PrimarySample`).
+#[derive(Clone, Copy, Debug, Default)]
+struct PrimarySample {
+    /// Its value in [0, 1).
+    value: f32,
+    /// The iteration that last changed it.
+    last_modified: u64,
+    /// The value before the proposal under way, restored if it is rejected.
+    value_backup: f32,
+    /// `last_modified` before the proposal under way.
+    modify_backup: u64,
+}
+
+impl PrimarySample {
+    fn backup(&mut self) {
+        self.value_backup = self.value;
+        self.modify_backup = self.last_modified;
+    }
+
+    fn restore(&mut self) {
+        self.value = self.value_backup;
+        self.last_modified = self.modify_backup;
+    }
+}
+
+/// A Markov chain's state in primary sample space and its mutations (pbrt-v3's `MLTSampler`).
+#[derive(Clone, Debug)]
+pub struct MltSampler {
+    /// The coordinates asked for so far, interleaved by stream.
+    x: Vec<PrimarySample>,
+    /// Draws the mutations.
+    rng: Pcg32,
+    /// The width of a small step.
+    sigma: f32,
+    /// The chance that a proposal is a large step.
+    large_step_probability: f32,
+    /// The iteration under way (0: the chain's first state).
+    current_iteration: u64,
+    /// Whether the proposal under way is a large step (the first state is one).
+    large_step: bool,
+    /// The iteration of the last accepted large step.
+    last_large_step_iteration: u64,
+    /// The stream the path draws from now.
+    stream_index: u32,
+    /// The next coordinate of that stream.
+    sample_index: u32,
+}
+
+impl MltSampler {
+    /// The sampler of bootstrap path `index` under `seed`: a chain that starts from it draws the
+    /// same first state (pbrt-v3 seeds its RNG by the index alone; acr adds the render's seed).
+    pub fn new(seed: u64, index: u64, sigma: f32, large_step_probability: f32) -> Self {
+        Self {
+            x: Vec::new(),
+            // The index is hashed into the seed: PCG streams whose seeds and increments
+            // differ by small steps start out correlated.
+            rng: {
+                let key = mix64(seed ^ 0x6d6c_745f_7361_6d70);
+                Pcg32::new(mix64(key ^ mix64(index)), mix64(key).wrapping_add(index))
+            },
+            sigma,
+            large_step_probability,
+            current_iteration: 0,
+            large_step: true,
+            last_large_step_iteration: 0,
+            stream_index: 0,
+            sample_index: 0,
+        }
+    }
+
+    /// Starts a proposal: a large step with the sampler's chance, else a small one.
+    pub fn start_iteration(&mut self) {
+        self.current_iteration += 1;
+        self.large_step = self.rng.next_f32() < self.large_step_probability;
+    }
+
+    /// Makes the path draw from stream `index` ([`CAMERA_STREAM`], ...), from its start.
+    pub fn start_stream(&mut self, index: u32) {
+        debug_assert!(index < STREAM_COUNT);
+        self.stream_index = index;
+        self.sample_index = 0;
+    }
+
+    /// The proposal was accepted.
+    pub fn accept(&mut self) {
+        if self.large_step {
+            self.last_large_step_iteration = self.current_iteration;
+        }
+    }
+
+    /// The proposal was rejected: the coordinates it moved get their values back.
+    pub fn reject(&mut self) {
+        for xi in &mut self.x {
+            if xi.last_modified == self.current_iteration {
+                xi.restore();
+            }
+        }
+        self.current_iteration -= 1;
+    }
+
+    /// Whether the proposal under way is a large step.
+    pub fn is_large_step(&self) -> bool {
+        self.large_step
+    }
+
+    /// The index in `x` of the current stream's next coordinate.
+    fn next_index(&mut self) -> usize {
+        let i = self.stream_index + STREAM_COUNT * self.sample_index;
+        self.sample_index += 1;
+        i as usize
+    }
+
+    /// Brings coordinate `index` up to the iteration under way (pbrt-v3's `EnsureReady`): the
+    /// small steps it missed since it was last used are applied as one of their summed width.
+    fn ensure_ready(&mut self, index: usize) {
+        if index >= self.x.len() {
+            self.x.resize(index + 1, PrimarySample::default());
+        }
+        let xi = &mut self.x[index];
+        // Reset a coordinate not used since the last accepted large step.
+        if xi.last_modified < self.last_large_step_iteration {
+            xi.value = self.rng.next_f32();
+            xi.last_modified = self.last_large_step_iteration;
+        }
+        xi.backup();
+        if self.large_step {
+            xi.value = self.rng.next_f32();
+        } else {
+            let n_small = self.current_iteration - xi.last_modified;
+            let normal = std::f32::consts::SQRT_2 * erf_inv(2.0 * self.rng.next_f32() - 1.0);
+            let eff_sigma = self.sigma * (n_small as f32).sqrt();
+            xi.value += normal * eff_sigma;
+            xi.value -= xi.value.floor();
+            // `v - floor(v)` of a tiny negative v rounds to 1.
+            if xi.value >= 1.0 {
+                xi.value = 0.0;
+            }
+        }
+        xi.last_modified = self.current_iteration;
+    }
+}
+
+impl SampleSource for MltSampler {
+    fn next_1d(&mut self) -> f32 {
+        let i = self.next_index();
+        self.ensure_ready(i);
+        self.x[i].value
+    }
+}
+
+/// The inverse error function (pbrt-v3's `ErfInv`, Giles' single-precision approximation).
+pub fn erf_inv(x: f32) -> f32 {
+    let x = x.clamp(-0.99999, 0.99999);
+    let mut w = -((1.0 - x) * (1.0 + x)).ln();
+    let p = if w < 5.0 {
+        w -= 2.5;
+        [
+            3.432_739_4e-7,
+            -3.523_387_7e-6,
+            -4.391_506_5e-6,
+            0.000_218_580_87,
+            -0.001_253_725,
+            -0.004_177_681_6,
+            0.246_640_73,
+            1.501_409_4,
+        ]
+        .iter()
+        .fold(2.810_226_4e-8_f32, |p, &c| c + p * w)
+    } else {
+        w = w.sqrt() - 3.0;
+        [
+            0.000_100_950_56,
+            0.001_349_343_2,
+            -0.003_673_428_4,
+            0.005_739_507_7,
+            -0.007_622_461,
+            0.009_438_870_5,
+            1.001_674_1,
+            2.832_976_8,
+        ]
+        .iter()
+        .fold(-0.000_200_214_26_f32, |p, &c| c + p * w)
+    };
+    p * x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn erf_inv_inverts_erf() {
+        // erf(0.5) = 0.520499877813, erf(1) = 0.842700792950, erf(2) = 0.995322265019.
+        for (x, y) in [(0.5f32, 0.520_499_88f32), (1.0, 0.842_700_8), (2.0, 0.995_322_3)] {
+            assert!((erf_inv(y) - x).abs() < 1e-3 * x, "{x} {}", erf_inv(y));
+            assert!((erf_inv(-y) + x).abs() < 1e-3 * x);
+        }
+        assert_eq!(erf_inv(0.0), 0.0);
+    }
+
+    #[test]
+    fn a_rejected_proposal_restores_the_state_and_an_accepted_one_keeps_it() {
+        let mut s = MltSampler::new(7, 3, 0.01, 0.3);
+        let draw = |s: &mut MltSampler| -> Vec<f32> {
+            (0..STREAM_COUNT)
+                .flat_map(|k| {
+                    s.start_stream(k);
+                    [s.next_1d(), s.next_1d()]
+                })
+                .collect()
+        };
+        let values = |s: &MltSampler| s.x.iter().map(|p| p.value).collect::<Vec<_>>();
+        let first = draw(&mut s);
+        let first_state = values(&s);
+        assert!(first.iter().all(|v| (0.0..1.0).contains(v)));
+        // The same index and seed give the same first state (how a chain starts from its
+        // bootstrap path).
+        assert_eq!(draw(&mut MltSampler::new(7, 3, 0.01, 0.3)), first);
+        assert_ne!(draw(&mut MltSampler::new(8, 3, 0.01, 0.3)), first);
+        for _ in 0..50 {
+            s.start_iteration();
+            let large = s.is_large_step();
+            let proposed = draw(&mut s);
+            assert!(proposed.iter().all(|v| (0.0..1.0).contains(v)));
+            if !large {
+                // A small step moves each coordinate by about sigma (wrapped around).
+                for (a, b) in first.iter().zip(&proposed) {
+                    let d = (a - b).abs();
+                    assert!(d.min(1.0 - d) < 0.1, "{a} {b}");
+                }
+            }
+            s.reject();
+            assert_eq!(values(&s), first_state);
+        }
+        s.start_iteration();
+        draw(&mut s);
+        let proposed_state = values(&s);
+        assert_ne!(proposed_state, first_state);
+        s.accept();
+        s.start_iteration();
+        draw(&mut s);
+        s.reject();
+        assert_eq!(values(&s), proposed_state);
+    }
+}
