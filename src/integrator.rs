@@ -495,8 +495,7 @@ fn path_li(
             // A light sample here makes a path one longer than this one; a shorter one than
             // asked for is not traced.
             if depth + 1 >= min_depth {
-                let direct =
-                    next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
+                let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
                 if let Some(direct) = direct {
                     l += beta * direct;
                 }

@@ -154,7 +154,12 @@ pub(super) fn choose(
         None => {
             let stopped = args.time_limit.is_some() || args.noise_threshold.is_some();
             let named = named_here || desc.sampler.is_some() || desc.filter.is_some();
-            let needs_scene = args.mergeable || args.sample_offset > 0;
+            // mlt makes its own samples: no sampler nor filter to choose.
+            let integrator = args
+                .integrator
+                .as_deref()
+                .or(desc.integrator.as_ref().map(|i| i.kind.as_str()));
+            let needs_scene = args.mergeable || args.sample_offset > 0 || integrator == Some("mlt");
             Ok((stopped && !named && !needs_scene).then(|| row_for(dims)))
         }
     }

@@ -49,12 +49,18 @@ pub(super) fn render_scene(
 ) -> Result<Rendered, String> {
     let mut film = job.plugins.film(&job.scene);
     let bar = progress_bar(args.quiet);
-    let spp = job.plugins.sampler.spp();
+    let spp = match &job.plugins.integrator {
+        // What mlt's --spp sets.
+        Integrator::Mlt(m) => m.mutations_per_pixel,
+        _ => job.plugins.sampler.spp(),
+    };
     if args.noise_threshold.is_some() && matches!(job.plugins.integrator, Integrator::Mlt(_)) {
-        return Err("--noise-threshold cannot be used with the mlt integrator: it drives its \
+        return Err(
+            "--noise-threshold cannot be used with the mlt integrator: it drives its \
                     own sampling (Markov chains) and keeps no per-pixel error estimate; use \
                     --spp (its mutations per pixel) or --time-limit"
-            .to_owned());
+                .to_owned(),
+        );
     }
     if let Some(t) = args.noise_threshold {
         // An adaptive sampler that can stops where it is settled; the render loop's global

@@ -7,9 +7,9 @@ use crate::camera::CameraSample;
 use crate::geometry::{Spectrum, Vec2};
 use crate::integrator::path_of_depth;
 use crate::lightdistrib::LightStrategy;
-use acr_plugins::RenderingSpace;
 use crate::scene::Scene;
 use crate::stream::SampleSource;
+use acr_plugins::RenderingSpace;
 
 /// One evaluation of the path function: the radiance it carries to the film and where.
 #[derive(Clone, Copy, Debug, Default)]

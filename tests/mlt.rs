@@ -1,0 +1,230 @@
+//! `mlt` (docs/light-transport.md, `## mlt`): its image mean against `path`'s on the same
+//! scene, the same image whatever the thread count, the time limit stopping it, and located
+//! errors for nonsense parameters and for samplers it cannot use.
+
+mod common;
+
+use acr::geometry::Spectrum;
+use acr::parser::{parse_str, SceneDescription};
+use acr::registry::{choose_for_scene, Overrides};
+use acr::render::{render, Halt};
+use acr::scene::Scene;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// mlt's test scene (a cropped 48x48 Cornell box).
+fn scene_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/pbrt-v3/mlt-cornell.pbrt")
+}
+
+/// The test scene's text with `from` replaced by `to` (which must be there).
+fn scene_text(from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(scene_path()).unwrap();
+    assert!(text.contains(from), "{from}");
+    text.replace(from, to)
+}
+
+fn parse(text: &str) -> SceneDescription {
+    parse_str(text, Path::new("mlt.pbrt")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The image of `text` with `integrator` at `spp` (mlt: mutations per pixel) and `seed`,
+/// stopped at `limit`, with the render's counts.
+fn render_text(
+    text: &str,
+    integrator: &str,
+    spp: u32,
+    seed: u64,
+    limit: Option<Duration>,
+) -> (Vec<Spectrum>, acr::render::RenderCounts) {
+    let desc = parse(text);
+    let mut warnings = Vec::new();
+    let scene = Scene::build(&desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+    let overrides = Overrides {
+        integrator: Some(integrator.to_owned()),
+        ..Overrides::default()
+    };
+    let mut plugins = choose_for_scene(&desc, &scene, &overrides, Some(spp), seed, &mut warnings)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut film = plugins.film(&scene);
+    let counts = render(
+        &scene,
+        &plugins.integrator,
+        plugins.sampler.as_mut(),
+        &mut film,
+        seed,
+        limit,
+        None,
+    );
+    (plugins.image(&film), counts)
+}
+
+fn mean(image: &[Spectrum]) -> Spectrum {
+    image.iter().copied().sum::<Spectrum>() / image.len() as f32
+}
+
+fn luminance(c: Spectrum) -> f32 {
+    acr::spectrum_luminance(c)
+}
+
+/// mlt's mean is `b`, the bootstrap's estimate of the image's luminance, coloured by the
+/// chains: within 1% of a long `path` render of the same scene (maxdepth 5 both), each channel
+/// within 1.5% (measured: luminance within 0.3% over seeds 1 to 4, channels within 0.8%).
+#[test]
+fn the_mean_agrees_with_path() {
+    let text = std::fs::read_to_string(scene_path()).unwrap();
+    let (mlt, counts) = render_text(&text, "mlt", 1024, 1, None);
+    assert_eq!(counts.dropped, 0);
+    assert!(!counts.halted);
+    assert_eq!(counts.samples, 48 * 36 * 1024);
+    let (path, _) = render_text(&text, "path", 1024, 1, None);
+    let (m, p) = (mean(&mlt), mean(&path));
+    let rel = |a: f32, b: f32| (a / b - 1.0).abs();
+    assert!(rel(luminance(m), luminance(p)) < 0.01, "mlt {m} path {p}");
+    for c in 0..3 {
+        assert!(rel(m[c], p[c]) < 0.015, "mlt {m} path {p}");
+    }
+    // Not the same image by another route: mlt's splats, every pixel reached.
+    assert!(mlt.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
+    assert!(mlt.iter().filter(|c| luminance(**c) > 0.0).count() > mlt.len() * 9 / 10);
+}
+
+/// Chains run in parallel but reach the film in chain order: the same image on 1 and 2
+/// threads, byte for byte; another seed, another image.
+#[test]
+fn the_image_is_the_same_whatever_the_thread_count() {
+    let text = scene_text("[100000]", "[5000]");
+    let on = |threads: usize, seed: u64| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| render_text(&text, "mlt", 32, seed, None).0)
+    };
+    let one = on(1, 2);
+    assert_eq!(one, on(2, 2));
+    assert_ne!(one, on(2, 3));
+}
+
+/// The time limit stops the chains between rounds; the image is scaled by the mutations made,
+/// so its mean is still the bootstrap's (not a fraction of it).
+#[test]
+fn the_time_limit_stops_it() {
+    let text = scene_text("[100000]", "[5000]");
+    let (full, _) = render_text(&text, "mlt", 16, 4, None);
+    let (image, counts) = render_text(&text, "mlt", 100_000, 4, Some(Duration::from_millis(50)));
+    assert!(counts.halted, "{counts:?}");
+    assert_eq!(counts.halted_by, Some(Halt::Time));
+    assert!(counts.samples > 0 && counts.samples < 48 * 36 * 100_000);
+    // The same bootstrap (seed and its parameters), so the same luminance mean.
+    let (a, b) = (luminance(mean(&image)), luminance(mean(&full)));
+    assert!((a / b - 1.0).abs() < 1e-3, "{a} {b}");
+}
+
+/// The error choosing the plugins of `text` gives (with `overrides`).
+fn choose_error(text: &str, overrides: &Overrides) -> String {
+    let desc = parse(text);
+    let mut warnings = Vec::new();
+    let scene = Scene::build(&desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
+    match choose_for_scene(&desc, &scene, overrides, None, 0, &mut warnings) {
+        Ok(_) => panic!("no error for {overrides:?}:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Nonsense parameters are errors at the parameter (file:line:col), never a panic.
+#[test]
+fn nonsense_parameters_are_located_errors() {
+    for (from, to, says) in [
+        (
+            "\"integer chains\" [1000]",
+            "\"integer chains\" [0]",
+            "chains 0",
+        ),
+        (
+            "\"float sigma\" [0.01]",
+            "\"float sigma\" [-0.5]",
+            "sigma -0.5",
+        ),
+        (
+            "\"float largestepprobability\" [0.3]",
+            "\"float largestepprobability\" [1.5]",
+            "largestepprobability 1.5",
+        ),
+        (
+            "\"integer mutationsperpixel\" [100]",
+            "\"integer mutationsperpixel\" [-3]",
+            "mutationsperpixel -3",
+        ),
+        (
+            "\"integer bootstrapsamples\" [100000]",
+            "\"integer bootstrapsamples\" [0]",
+            "bootstrapsamples 0",
+        ),
+        (
+            "\"integer maxdepth\" [5]",
+            "\"integer maxdepth\" [-1]",
+            "maxdepth -1",
+        ),
+    ] {
+        let e = choose_error(&scene_text(from, to), &Overrides::default());
+        // The Integrator directive's parameters are on lines 16 to 18.
+        assert!(e.contains(says) && e.contains("mlt.pbrt:1"), "{e}");
+    }
+}
+
+/// mlt drives its own sampling: an adaptive sampler is refused with a message that says so
+/// (a plain one is not, and its --spp is mlt's mutations per pixel), and so is
+/// --noise-threshold.
+#[test]
+fn adaptive_samplers_and_the_noise_threshold_are_refused() {
+    let text = std::fs::read_to_string(scene_path()).unwrap();
+    for sampler in ["cluster", "mdas", "gem", "awr"] {
+        let overrides = Overrides {
+            sampler: Some(sampler.to_owned()),
+            ..Overrides::default()
+        };
+        let e = choose_error(&text, &overrides);
+        assert!(
+            e.contains("drives its own sampling") && e.contains(sampler),
+            "{e}"
+        );
+    }
+    let dir = common::temp_dir("mlt-noise");
+    let out = dir.join("x.pfm");
+    let scene = scene_path();
+    common::fails(
+        &[
+            "render",
+            common::s(&scene),
+            "--noise-threshold",
+            "0.1",
+            "-o",
+            common::s(&out),
+        ],
+        "drives its own sampling",
+    );
+    // A time limit without a named sampler keeps mlt (no auto pipeline), and the stats give
+    // its mutations per pixel as spp.
+    let stats = dir.join("s.json");
+    let text = scene_text("[100000]", "[2000]").replace("Sampler \"halton\"", "#");
+    let small = dir.join("small.pbrt");
+    std::fs::write(&small, text).unwrap();
+    common::ok(&[
+        "render",
+        common::s(&small),
+        "--time-limit",
+        "30",
+        "--spp",
+        "8",
+        "--quiet",
+        "-o",
+        common::s(&out),
+        "--stats",
+        common::s(&stats),
+    ]);
+    let stats = std::fs::read_to_string(stats).unwrap();
+    assert!(stats.contains("\"integrator\": \"mlt\""), "{stats}");
+    assert!(stats.contains("\"spp\": 8,"), "{stats}");
+    assert!(stats.contains("\"pipeline\": \"scene\""), "{stats}");
+}
