@@ -76,7 +76,7 @@ fn the_mean_agrees_with_path() {
     let (mlt, counts) = render_text(&text, "mlt", 1024, 1, None);
     assert_eq!(counts.dropped, 0);
     assert!(!counts.halted);
-    assert_eq!(counts.samples, 48 * 36 * 1024);
+    assert_eq!(counts.samples, 48 * 48 * 1024);
     let (path, _) = render_text(&text, "path", 1024, 1, None);
     let (m, p) = (mean(&mlt), mean(&path));
     let rel = |a: f32, b: f32| (a / b - 1.0).abs();
@@ -115,7 +115,7 @@ fn the_time_limit_stops_it() {
     let (image, counts) = render_text(&text, "mlt", 100_000, 4, Some(Duration::from_millis(50)));
     assert!(counts.halted, "{counts:?}");
     assert_eq!(counts.halted_by, Some(Halt::Time));
-    assert!(counts.samples > 0 && counts.samples < 48 * 36 * 100_000);
+    assert!(counts.samples > 0 && counts.samples < 48 * 48 * 100_000);
     // The same bootstrap (seed and its parameters), so the same luminance mean.
     let (a, b) = (luminance(mean(&image)), luminance(mean(&full)));
     assert!((a / b - 1.0).abs() < 1e-3, "{a} {b}");
