@@ -136,6 +136,12 @@ pub fn render(data: &[u8]) {
             *max_depth = (*max_depth).min(8);
         }
         Integrator::VolPath(settings) => settings.max_depth = settings.max_depth.min(8),
+        // A small bootstrap and few chains, so that a scene's defaults cannot stall it.
+        Integrator::Mlt(settings) => {
+            settings.max_depth = settings.max_depth.min(8);
+            settings.bootstrap_samples = settings.bootstrap_samples.min(64);
+            settings.chains = settings.chains.min(16);
+        }
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

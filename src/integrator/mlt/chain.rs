@@ -20,6 +20,9 @@ use std::time::Instant;
 /// the time limit is looked at (about a second's work on two cores for a simple scene).
 const MUTATIONS_PER_ROUND: u64 = 1 << 18;
 
+/// One chain's round: its splats, what it counted, the mutations it made.
+type Round = (Vec<(Vec2, Spectrum)>, Tally, u64);
+
 /// What the chains share: the path function, the scene and the settings.
 struct Setup<'a, F> {
     f: &'a F,
@@ -277,7 +280,7 @@ pub fn render_with<F: PathContribution>(
     let mut made = 0u64;
     let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     while chains.iter().any(|c| c.left > 0) {
-        let rounds: Vec<(Vec<(Vec2, Spectrum)>, Tally, u64)> = chains
+        let rounds: Vec<Round> = chains
             .par_iter_mut()
             .map(|c| {
                 let (mut splats, mut t) = (Vec::new(), Tally::default());

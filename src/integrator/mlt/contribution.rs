@@ -28,14 +28,17 @@ pub struct Contribution {
 /// raster area sampled): mlt's bootstrap estimates that total, and the chains its share per
 /// pixel.
 ///
-/// pbrt-v3's `L`, the shape the bdpt adapter takes: `start_stream(CAMERA_STREAM)`; for
-/// `depth` 0 the one strategy `s = 0, t = 2` (`n_strategies = 1`), else `n_strategies = depth
-/// + 2` and `s = min(floor(next_1d() * n_strategies), n_strategies - 1)`, `t = n_strategies -
-/// s`; the raster position `space.min + next_2d() * extent`, the time `next_1d()`, the lens
-/// `next_2d()`; `generate_camera_subpath(.., t, ..)` (0 unless it made all `t` vertices);
-/// `start_stream(LIGHT_STREAM)`, `generate_light_subpath(.., s, ..)` (0 unless it made `s`);
-/// `start_stream(CONNECTION_STREAM)`, `connect(.., s, t, ..)` (which may move the raster
-/// position, for `t = 1`), times `n_strategies` (one strategy chosen uniformly of them).
+/// pbrt-v3's `L`, the shape the bdpt adapter takes:
+///
+/// 1. `start_stream(CAMERA_STREAM)`; for `depth` 0 the one strategy `s = 0, t = 2`
+///    (`n_strategies = 1`), else `n_strategies = depth + 2`,
+///    `s = min(floor(next_1d() * n_strategies), n_strategies - 1)`, `t = n_strategies - s`;
+/// 2. the raster position `space.min + next_2d() * extent`, the time `next_1d()`, the lens
+///    `next_2d()`; `generate_camera_subpath(.., t, ..)` (zero unless it made all `t` vertices);
+/// 3. `start_stream(LIGHT_STREAM)`, `generate_light_subpath(.., s, ..)` (zero unless it made
+///    all `s`);
+/// 4. `start_stream(CONNECTION_STREAM)`, `connect(.., s, t, ..)` (which may move the raster
+///    position, for `t = 1`), times `n_strategies` (one strategy chosen uniformly of them).
 pub trait PathContribution: Sync {
     /// The longest path, in scattering vertices (pbrt-v3's `maxdepth`).
     fn max_depth(&self) -> u32;

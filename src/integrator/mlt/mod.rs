@@ -75,7 +75,7 @@ pub const ENTRY: Entry<IntegratorBuild> = Entry {
             ),
         ],
     },
-    build: build,
+    build,
 };
 
 /// An error at parameter `name`'s location (or naming it, when it has none).
