@@ -204,6 +204,18 @@ fn adaptive_samplers_and_the_noise_threshold_are_refused() {
         ],
         "drives its own sampling",
     );
+    // Its image is normalised by its own bootstrap: sample ranges cannot be merged.
+    let exr = dir.join("x.exr");
+    common::fails(
+        &[
+            "render",
+            common::s(&scene),
+            "--mergeable",
+            "-o",
+            common::s(&exr),
+        ],
+        "sample ranges do not add up",
+    );
     // A time limit without a named sampler keeps mlt (no auto pipeline), and the stats give
     // its mutations per pixel as spp.
     let stats = dir.join("s.json");
@@ -227,4 +239,60 @@ fn adaptive_samplers_and_the_noise_threshold_are_refused() {
     assert!(stats.contains("\"integrator\": \"mlt\""), "{stats}");
     assert!(stats.contains("\"spp\": 8,"), "{stats}");
     assert!(stats.contains("\"pipeline\": \"scene\""), "{stats}");
+}
+
+/// SIGTERM stops the chains after the round under way: the image so far is written (partial
+/// images appear between rounds), with the mutations per pixel made in the message, and its
+/// mean is the bootstrap's as a finished render's (the scale follows the mutations made).
+// Signals, and `libc::kill` to send one, are Unix only.
+#[cfg(unix)]
+#[test]
+fn sigterm_writes_the_image_so_far() {
+    let dir = common::temp_dir("mlt-signal");
+    let scene = dir.join("small.pbrt");
+    std::fs::write(&scene, scene_text("[100000]", "[5000]")).unwrap();
+    let (out, full) = (dir.join("partial.pfm"), dir.join("full.pfm"));
+    let seed = ["--seed", "5", "--quiet"];
+    let mut args = vec!["render", common::s(&scene), "-o", common::s(&full)];
+    common::ok(&[&args[..], &seed, &["--spp", "8"]].concat());
+    args[3] = common::s(&out);
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_acr"))
+        .args(&args)
+        .args(seed)
+        .args([
+            "--spp",
+            "1000000",
+            "--threads",
+            "1",
+            "--write-partial-images",
+            "0.2",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !out.exists() {
+        assert!(start.elapsed().as_secs() < 120, "no partial image");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // SAFETY: kill(2) on our own child's pid, with a valid signal number.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) },
+        0
+    );
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && output.status.code().is_some(),
+        "{err}"
+    );
+    assert!(err.contains("interrupted by a signal after"), "{err}");
+    assert!(!err.contains("after 0 of"), "{err}");
+    let lum = |p: &Path| {
+        let (img, _) = acr::image_io::read_image_with_frame(p).unwrap();
+        luminance(mean(&img.pixels))
+    };
+    let (a, b) = (lum(&out), lum(&full));
+    assert!((a / b - 1.0).abs() < 1e-3, "{a} {b}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -173,11 +173,23 @@ pub(super) fn report_end(
     Ok(())
 }
 
+/// The mutations per pixel an mlt render made (its film holds splats, no samples); `None`
+/// for a render whose film holds its samples.
+fn mutations_made(rendered: &Rendered, pixels: usize) -> Option<u32> {
+    let splats_only = rendered.film.pixel_stats().iter().all(|p| p.count == 0);
+    (splats_only && rendered.counts.samples > 0)
+        .then(|| (rendered.counts.samples / pixels.max(1) as u64).min(u64::from(u32::MAX)) as u32)
+}
+
 /// The error of a render a signal stopped: how far it got, where the image so far is, and
 /// how to finish it.
 fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> String {
     let spp = rendered.spp;
-    let reached = reached_spp(&rendered.film.pixel_stats());
+    let stats = rendered.film.pixel_stats();
+    let reached = match mutations_made(rendered, stats.len()) {
+        Some(m) => m,
+        None => reached_spp(&stats),
+    };
     let resume = if target.out.can_merge {
         // The rest's default footprint is this render's unless the command line chose one.
         let footprint = args

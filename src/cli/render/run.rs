@@ -54,13 +54,8 @@ pub(super) fn render_scene(
         Integrator::Mlt(m) => m.mutations_per_pixel,
         _ => job.plugins.sampler.spp(),
     };
-    if args.noise_threshold.is_some() && matches!(job.plugins.integrator, Integrator::Mlt(_)) {
-        return Err(
-            "--noise-threshold cannot be used with the mlt integrator: it drives its \
-                    own sampling (Markov chains) and keeps no per-pixel error estimate; use \
-                    --spp (its mutations per pixel) or --time-limit"
-                .to_owned(),
-        );
+    if matches!(job.plugins.integrator, Integrator::Mlt(_)) {
+        refuse_with_mlt(args)?;
     }
     if let Some(t) = args.noise_threshold {
         // An adaptive sampler that can stops where it is settled; the render loop's global
@@ -115,6 +110,28 @@ pub(super) fn render_scene(
         batches,
         spp,
     })
+}
+
+/// The options mlt cannot honour: it drives its own sampling (Markov chains), keeps no
+/// per-pixel error estimate, and normalises its image by its own bootstrap.
+fn refuse_with_mlt(args: &RenderArgs) -> Result<(), String> {
+    if args.noise_threshold.is_some() {
+        return Err(
+            "--noise-threshold cannot be used with the mlt integrator: it drives its \
+                    own sampling (Markov chains) and keeps no per-pixel error estimate; use \
+                    --spp (its mutations per pixel) or --time-limit"
+                .to_owned(),
+        );
+    }
+    if args.mergeable || args.sample_offset > 0 {
+        return Err(
+            "--mergeable and --sample-offset cannot be used with the mlt integrator: \
+                    it drives its own sampling (Markov chains) and normalises each render by \
+                    its own bootstrap, so sample ranges do not add up"
+                .to_owned(),
+        );
+    }
+    Ok(())
 }
 
 /// What looks at the image as it renders: the partial images written to the output, the

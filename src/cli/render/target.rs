@@ -61,7 +61,14 @@ fn output_of(args: &RenderArgs, job: &Job, path: PathBuf, is_exr: bool) -> Outpu
         size: (w as usize, h as usize),
         scale: film.scale,
         mergeable: args.mergeable,
-        can_merge: is_exr && job.splats && job.plugins.sampler.streams() == 1,
+        // mlt's image is normalised by its own bootstrap: its ranges do not add up.
+        can_merge: is_exr
+            && job.splats
+            && job.plugins.sampler.streams() == 1
+            && !matches!(
+                job.plugins.integrator,
+                crate::integrator::Integrator::Mlt(_)
+            ),
         offset: args.sample_offset,
         channel_aovs: Vec::new(),
         // Only an EXR carries the hash: a PNG or PFM render does not read the scene again.
