@@ -216,6 +216,7 @@ pub fn render(
     let f = PathTraced {
         max_depth: settings.max_depth,
         light_strategy: LightStrategy::Bvh,
+        differential_scale: 1.0 / (settings.mutations_per_pixel.max(1) as f32).sqrt(),
     };
     render_with(&f, scene, settings, film, seed, stop, progress)
 }

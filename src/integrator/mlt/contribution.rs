@@ -64,6 +64,9 @@ pub struct PathTraced {
     pub max_depth: u32,
     /// How a light is chosen for a light sample.
     pub light_strategy: LightStrategy,
+    /// The camera ray's differentials' scale: 1/sqrt(mutations per pixel), as pbrt-v3's bdpt
+    /// scales them by its sampler's samples per pixel (the MLT sampler's are its mutations).
+    pub differential_scale: f32,
 }
 
 impl PathContribution for PathTraced {
@@ -89,7 +92,7 @@ impl PathContribution for PathTraced {
         };
         let r = if scene.uses_differentials {
             let (ray, diff) = scene.camera.generate_ray_differential(&sample);
-            let diff = diff.scaled(&ray, scene.differential_scale);
+            let diff = diff.scaled(&ray, self.differential_scale);
             path_of_depth(scene, ray, Some(&diff), sampler, depth, self.light_strategy)
         } else {
             let ray = scene.camera.generate_ray(&sample);
