@@ -99,7 +99,9 @@ fn the_image_is_the_same_whatever_the_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| render_text(&text, "mlt", 32, seed, None).0)
+        // 256 mutations per pixel: three rounds of 2^18 mutations, so the order of the
+        // splats across rounds is tested too.
+        pool.install(|| render_text(&text, "mlt", 256, seed, None).0)
     };
     let one = on(1, 2);
     assert_eq!(one, on(2, 2));
