@@ -132,10 +132,13 @@ pub fn render(data: &[u8]) {
         return;
     };
     match &mut plugins.integrator {
-        Integrator::Path { max_depth, .. } | Integrator::Direct { max_depth, .. } => {
+        Integrator::Path { max_depth, .. }
+        | Integrator::Direct { max_depth, .. }
+        | Integrator::Whitted { max_depth } => {
             *max_depth = (*max_depth).min(8);
         }
         Integrator::VolPath(settings) => settings.max_depth = settings.max_depth.min(8),
+        Integrator::AmbientOcclusion(settings) => settings.samples = settings.samples.min(8),
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

@@ -271,9 +271,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, mlt, sppm, \
-         ambientocclusion -> path (bdpt and mlt -> volpath on a scene with media), whitted -> \
-         directlighting.\n",
+         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, mlt, sppm -> \
+         path (bdpt and mlt -> volpath on a scene with media).\n",
     );
     out
 }

@@ -105,8 +105,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Integrator, "bdpt", "path"),
     (Kind::Integrator, "mlt", "path"),
     (Kind::Integrator, "sppm", "path"),
-    (Kind::Integrator, "ambientocclusion", "path"),
-    (Kind::Integrator, "whitted", "directlighting"),
 ];
 
 /// Finds the plugin called `name` among `entries` (of kind `kind`). A pbrt-v3 name acr lacks
