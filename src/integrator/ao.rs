@@ -58,8 +58,19 @@ pub fn ao_li(scene: &Scene, mut ray: Ray, stream: &mut SampleStream, s: AoSettin
     }
     let count = s.samples as f32;
     let mut l = 0.0f32;
-    for _ in 0..s.samples {
-        let u = stream.next_2d();
+    // pbrt-v3 draws the directions as one array from its sampler, stratified over the pixel's
+    // samples together; here a Hammersley set of `nsamples` points shifted (mod 1) by one
+    // stream point: each direction still uniform, the set stratified, the shift stratified
+    // across the pixel's samples.
+    let shift = stream.next_2d();
+    let inv_count = 1.0 / count;
+    for i in 0..s.samples {
+        // The base-2 radical inverse is i's bits reversed.
+        let h = glam::Vec2::new(
+            (i as f32 + 0.5) * inv_count,
+            i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0),
+        );
+        let u = (h + shift).fract();
         let (w, pdf) = if s.cos_sample {
             let w = cosine_sample_hemisphere(u);
             (w, w.z.abs() * std::f32::consts::FRAC_1_PI)
