@@ -5,7 +5,6 @@
 //! pbrt-v3's `RealisticCamera` (docs/cameras.md).
 
 use crate::geometry::{Vec2, Vec3};
-use crate::lightdistrib::radical_inverse;
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -264,7 +263,8 @@ impl LensSystem {
             } else {
                 intersect_spherical(e.curvature_radius, element_z + e.curvature_radius, &ray)?
             };
-            if !(t >= 0.0) {
+            // Behind the ray, or NaN.
+            if t.is_nan() || t < 0.0 {
                 return None;
             }
             let hit = ray.o + ray.d * t;
@@ -303,7 +303,8 @@ impl LensSystem {
             } else {
                 intersect_spherical(e.curvature_radius, element_z + e.curvature_radius, &ray)?
             };
-            if !(t >= 0.0) {
+            // Behind the ray, or NaN.
+            if t.is_nan() || t < 0.0 {
                 return None;
             }
             let hit = ray.o + ray.d * t;
@@ -357,7 +358,7 @@ impl LensSystem {
         let f = fz[0] - pz[0];
         let z = -focus_distance;
         let c = (pz[1] - z - pz[0]) * (pz[1] - z - 4.0 * f - pz[0]);
-        if !(c > 0.0) {
+        if c.is_nan() || c <= 0.0 {
             return Err(LensError::TooClose(focus_distance));
         }
         let delta = 0.5 * (pz[1] - z + pz[0] - c.sqrt());
@@ -378,7 +379,7 @@ impl LensSystem {
         for i in 0..samples {
             let t = (i as f32 + 0.5) / samples as f32;
             let film = Vec3::new((1.0 - t) * x0 + t * x1, 0.0, 0.0);
-            let u = Vec2::new(radical_inverse(2, i), radical_inverse(3, i));
+            let u = Vec2::new(radical_inverse_2(i), radical_inverse_3(i));
             let p = proj.lerp(u);
             let rear_point = Vec3::new(p.x, p.y, rear_z);
             if pupil.inside(p)
@@ -456,6 +457,24 @@ impl LensSystem {
     }
 }
 
+/// pbrt-v3's `RadicalInverse(0, i)`: the bits of `i` reversed, as a fraction.
+fn radical_inverse_2(i: u32) -> f32 {
+    (f64::from(i.reverse_bits()) * (1.0 / 4_294_967_296.0)) as f32
+}
+
+/// pbrt-v3's `RadicalInverse(1, i)`: the base-3 digits of `i` reversed, in f32 as pbrt-v3's.
+fn radical_inverse_3(mut i: u32) -> f32 {
+    let inv_base = 1.0f32 / 3.0;
+    let (mut reversed, mut inv_base_n) = (0u64, 1.0f32);
+    while i > 0 {
+        let next = i / 3;
+        reversed = reversed * 3 + u64::from(i - next * 3);
+        inv_base_n *= inv_base;
+        i = next;
+    }
+    (reversed as f32 * inv_base_n).min(1.0 - f32::EPSILON / 2.0)
+}
+
 /// pbrt-v3's `ComputeCardinalPoints`: the z of the focal point and of the principal plane
 /// from a ray parallel to the axis and the ray it leaves as.
 fn cardinal_points(r_in: &LensRay, r_out: &LensRay) -> (f32, f32) {
@@ -487,7 +506,7 @@ fn intersect_spherical(radius: f32, z_center: f32, ray: &LensRay) -> Option<(f32
 /// pbrt-v3's `Quadratic`: the discriminant in double precision, the roots ordered.
 fn quadratic(a: f32, b: f32, c: f32) -> Option<(f32, f32)> {
     let discrim = f64::from(b) * f64::from(b) - 4.0 * f64::from(a) * f64::from(c);
-    if !(discrim >= 0.0) {
+    if discrim.is_nan() || discrim < 0.0 {
         return None;
     }
     let root = discrim.sqrt();

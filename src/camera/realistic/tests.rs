@@ -1,4 +1,5 @@
 use super::*;
+use crate::lightdistrib::radical_inverse;
 
 const DGAUSS: &str = include_str!("../../../scenes/pbrt-v3/lenses/dgauss.50mm.dat");
 
