@@ -6,7 +6,6 @@
 use super::{Radiance, MAX_PASS_THROUGH};
 use crate::first_hit::FirstHit;
 use crate::geometry::{Ray, Spectrum, Vec3};
-use crate::sampling::cosine_sample_hemisphere;
 use crate::scene::Scene;
 use crate::stream::SampleStream;
 
@@ -71,19 +70,27 @@ pub fn ao_li(scene: &Scene, mut ray: Ray, stream: &mut SampleStream, s: AoSettin
             i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0),
         );
         let u = (h + shift).fract();
+        // Polar mappings (the stratified set keeps its spread) with an inline sin/cos: the
+        // library's was a sixth of the integrator's time.
+        let (sin, cos) = sin_cos_2pi(u.y);
         let (w, pdf) = if s.cos_sample {
-            let w = cosine_sample_hemisphere(u);
-            (w, w.z.abs() * std::f32::consts::FRAC_1_PI)
+            // Malley's method: r = sqrt(u), z = sqrt(1 - u) > 0.
+            let r = u.x.sqrt();
+            let z = (1.0 - u.x).sqrt();
+            (
+                Vec3::new(r * cos, r * sin, z),
+                z * std::f32::consts::FRAC_1_PI,
+            )
         } else {
             let z = u.x;
             let r = (1.0 - z * z).max(0.0).sqrt();
-            let phi = 2.0 * std::f32::consts::PI * u.y;
             (
-                Vec3::new(r * phi.cos(), r * phi.sin(), z),
+                Vec3::new(r * cos, r * sin, z),
                 0.5 * std::f32::consts::FRAC_1_PI,
             )
         };
-        // A grazing cosine sample has pdf 0 and adds nothing (pbrt-v3's would be 0/0).
+        // A direction at the horizon would have pdf 0 (0/0 in pbrt-v3): never drawn here, as
+        // u.x < 1; kept as a guard.
         if pdf <= 0.0 {
             continue;
         }
@@ -102,5 +109,38 @@ pub fn ao_li(scene: &Scene, mut ray: Ray, stream: &mut SampleStream, s: AoSettin
             normal: n,
             depth: travelled,
         },
+    }
+}
+
+/// sin and cos of 2 pi t (t in [0, 1]): the angle reduced to a quarter turn's nearest multiple
+/// and a remainder within pi/4, whose Taylor series to the 7th and 8th powers are exact to
+/// 3e-7.
+#[inline]
+fn sin_cos_2pi(t: f32) -> (f32, f32) {
+    let q4 = t * 4.0;
+    let q = q4.round();
+    let a = (q4 - q) * std::f32::consts::FRAC_PI_2;
+    let a2 = a * a;
+    let s = a * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0)));
+    let c = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0)));
+    match (q as i32) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn sin_cos_2pi_is_accurate() {
+        for i in 0..=4096 {
+            let t = i as f32 / 4096.0;
+            let (s, c) = super::sin_cos_2pi(t);
+            let a = 2.0 * std::f64::consts::PI * f64::from(t);
+            assert!((f64::from(s) - a.sin()).abs() < 1e-6, "{t}: {s}");
+            assert!((f64::from(c) - a.cos()).abs() < 1e-6, "{t}: {c}");
+        }
     }
 }
