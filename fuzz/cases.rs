@@ -132,7 +132,9 @@ pub fn render(data: &[u8]) {
         return;
     };
     match &mut plugins.integrator {
-        Integrator::Path { max_depth, .. } | Integrator::Direct { max_depth, .. } => {
+        Integrator::Path { max_depth, .. }
+        | Integrator::Direct { max_depth, .. }
+        | Integrator::Whitted { max_depth } => {
             *max_depth = (*max_depth).min(8);
         }
         Integrator::VolPath(settings) => settings.max_depth = settings.max_depth.min(8),
@@ -142,6 +144,7 @@ pub fn render(data: &[u8]) {
             settings.bootstrap_samples = settings.bootstrap_samples.min(64);
             settings.chains = settings.chains.min(16);
         }
+        Integrator::AmbientOcclusion(settings) => settings.samples = settings.samples.min(8),
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

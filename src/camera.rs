@@ -1,13 +1,29 @@
 //! pbrt-v3's cameras: `perspective` (field of view on the shorter image axis, screen window,
 //! thin lens), `orthographic` (screen window, thin lens) and `environment` (the whole sphere
-//! in latitude-longitude), with a shutter interval and a camera transform that may move.
-//! pbrt-v3's `realistic` (a lens system read from a file) is refused with a located error.
+//! in latitude-longitude) and `realistic` (a lens system read from a file, in
+//! `src/camera/realistic.rs`), with a shutter interval and a camera transform that may move.
 
 use crate::geometry::{Ray, RayDifferentials, Vec2, Vec3};
 use crate::sampling::concentric_sample_disk;
 use crate::transform::MotionTransform;
 use acr_parser::{CameraDesc, Error, Result};
 use glam::{Mat4, Vec4};
+use std::path::Path;
+use std::sync::Arc;
+
+pub mod realistic;
+use realistic::{LensError, LensSystem};
+
+/// What a camera needs besides its own directive: the film's `diagonal` (millimetres, the
+/// realistic camera's film size) and the directory the lens file's name is relative to.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraContext<'a> {
+    /// The film's diagonal in millimetres (pbrt-v3's `Film` "diagonal", default 35).
+    pub film_diagonal_mm: f32,
+    /// Where the lens file's name is looked up when it is relative (the main scene file's
+    /// directory, as pbrt-v3).
+    pub dir: &'a Path,
+}
 
 /// Where on the film, lens and shutter a camera ray starts.
 #[derive(Clone, Copy, Debug, Default)]
@@ -29,6 +45,8 @@ pub enum Projection {
     Orthographic,
     /// Every direction: x is the longitude, y the latitude (pbrt-v3's `environment`).
     Environment,
+    /// Through a lens system (pbrt-v3's `realistic`): rays carry a weight.
+    Realistic,
 }
 
 /// A camera.
@@ -48,6 +66,8 @@ pub struct Camera {
     pub shutter_open: f32,
     /// Shutter close time.
     pub shutter_close: f32,
+    /// The realistic camera's lens system.
+    lens: Option<Arc<LensSystem>>,
 }
 
 impl Camera {
@@ -58,25 +78,40 @@ impl Camera {
         resolution: (u32, u32),
         render_from_world: glam::DMat4,
     ) -> Result<Self> {
+        let context = CameraContext {
+            film_diagonal_mm: 35.0,
+            dir: desc.plugin.loc.file.dir(),
+        };
+        Self::with_context(
+            desc,
+            resolution,
+            render_from_world,
+            &context,
+            &mut Vec::new(),
+        )
+    }
+
+    /// [`Camera::new`] with what the realistic camera needs from the film and the scene's
+    /// place; its warnings (an aperture clamped to the stop's) go to `warnings`.
+    pub fn with_context(
+        desc: &CameraDesc,
+        resolution: (u32, u32),
+        render_from_world: glam::DMat4,
+        context: &CameraContext,
+        warnings: &mut Vec<acr_parser::Warning>,
+    ) -> Result<Self> {
         let p = &desc.plugin;
         let projection = match p.kind.as_str() {
             "perspective" => Projection::Perspective,
             "orthographic" => Projection::Orthographic,
             "environment" => Projection::Environment,
-            "realistic" => {
-                return Err(Error::at(
-                    &p.loc,
-                    "camera \"realistic\" (pbrt-v3's lens-system camera) is not supported; \
-                     \"perspective\" with \"lensradius\" and \"focaldistance\" gives a thin \
-                     lens",
-                ))
-            }
+            "realistic" => Projection::Realistic,
             other => {
                 return Err(Error::at(
                     &p.loc,
                     format!(
                         "camera \"{other}\" is not supported (perspective, orthographic, \
-                         environment)"
+                         environment, realistic)"
                     ),
                 ))
             }
@@ -108,8 +143,9 @@ impl Camera {
                 format!("fov {fov} is not between 0 and 180 degrees"),
             ));
         }
-        // The environment camera has no lens (pbrt-v3 reads no lens parameters for it).
-        let lens_radius = if projection == Projection::Environment {
+        // The environment and realistic cameras have no thin lens (pbrt-v3 reads no lens
+        // parameters for them).
+        let lens_radius = if matches!(projection, Projection::Environment | Projection::Realistic) {
             0.0
         } else {
             params.float_or("lensradius", 0.0)? as f32
@@ -144,6 +180,10 @@ impl Camera {
             end: render_from_world * desc.camera_from_world.end.inverse(),
             ..desc.camera_from_world
         };
+        let lens = match projection {
+            Projection::Realistic => Some(Arc::new(lens_system(desc, context, warnings)?)),
+            _ => None,
+        };
         Ok(Self {
             projection,
             resolution: (xres, yres),
@@ -153,7 +193,69 @@ impl Camera {
             focal_distance,
             shutter_open,
             shutter_close,
+            lens,
         })
+    }
+
+    /// True when camera rays need a lens sample (a thin lens, or a lens system).
+    pub fn uses_lens(&self) -> bool {
+        self.lens_radius > 0.0 || self.lens.is_some()
+    }
+
+    /// The ray for a camera sample, its differentials when `differentials` (scaled to one
+    /// pixel), and its weight: 1 for every camera but `realistic`, whose rays pbrt-v3
+    /// weights (cos^4 and the exit pupil's area) and which returns `None` for a sample the
+    /// lens vignettes (pbrt-v3's zero weight: the sample counts, black).
+    pub fn weighted_ray(
+        &self,
+        s: &CameraSample,
+        differentials: bool,
+    ) -> Option<(Ray, Option<RayDifferentials>, f32)> {
+        let Some(lens) = &self.lens else {
+            return Some(if differentials {
+                let (ray, diff) = self.generate_ray_differential(s);
+                (ray, Some(diff), 1.0)
+            } else {
+                (self.generate_ray(s), None, 1.0)
+            });
+        };
+        let (ray, weight) = self.realistic_ray(lens, s)?;
+        if !differentials {
+            return Some((ray, None, weight));
+        }
+        // pbrt-v3's Camera::GenerateRayDifferential: the rays of film points shifted by a
+        // twentieth of a pixel (back, when forward is vignetted), the same lens sample; no
+        // differentials, no ray.
+        let shifted = |step: Vec2| {
+            [0.05f32, -0.05].into_iter().find_map(|eps| {
+                let moved = CameraSample {
+                    film: s.film + step * eps,
+                    ..*s
+                };
+                let (r, _) = self.realistic_ray(lens, &moved)?;
+                Some((ray.o + (r.o - ray.o) / eps, ray.d + (r.d - ray.d) / eps))
+            })
+        };
+        let (rx_o, rx_d) = shifted(Vec2::X)?;
+        let (ry_o, ry_d) = shifted(Vec2::Y)?;
+        let diff = RayDifferentials {
+            rx_o,
+            rx_d,
+            ry_o,
+            ry_d,
+        };
+        Some((ray, Some(diff), weight))
+    }
+
+    /// A realistic camera's world-space ray and weight (pbrt-v3's
+    /// `RealisticCamera::GenerateRay`).
+    fn realistic_ray(&self, lens: &LensSystem, s: &CameraSample) -> Option<(Ray, f32)> {
+        let time = self.time(s);
+        let shutter = self.shutter_close - self.shutter_open;
+        let (r, weight) = lens.camera_ray(s.film, self.resolution, s.lens, shutter)?;
+        let m = self.world_from_camera.at(time);
+        let d = m.transform_vector3(r.d).normalize();
+        Some((Ray::new(m.transform_point3(r.o), d, time), weight))
     }
 
     /// True when the camera itself moves during the shutter.
@@ -166,8 +268,15 @@ impl Camera {
         &self.world_from_camera
     }
 
-    /// The world-space ray for a camera sample (direction normalised).
+    /// The world-space ray for a camera sample (direction normalised). The realistic
+    /// camera's weight is dropped, and a vignetted sample gives the ray along the lens's axis:
+    /// [`Camera::weighted_ray`] is the whole answer for it.
     pub fn generate_ray(&self, s: &CameraSample) -> Ray {
+        if let Some(lens) = &self.lens {
+            return self
+                .realistic_ray(lens, s)
+                .map_or_else(|| self.axis_ray(self.time(s)), |(ray, _)| ray);
+        }
         let time = self.time(s);
         let m = self.world_from_camera.at(time);
         let (o, d) = self.camera_space_ray(s.film, s.lens);
@@ -183,6 +292,19 @@ impl Camera {
     /// perspective and orthographic cameras compute the same rays in closed form; its
     /// environment camera shifts the film point as here).
     pub fn generate_ray_differential(&self, s: &CameraSample) -> (Ray, RayDifferentials) {
+        if self.lens.is_some() {
+            if let Some((ray, Some(diff), _)) = self.weighted_ray(s, true) {
+                return (ray, diff);
+            }
+            let ray = self.generate_ray(s);
+            let diff = RayDifferentials {
+                rx_o: ray.o,
+                rx_d: ray.d,
+                ry_o: ray.o,
+                ry_d: ray.d,
+            };
+            return (ray, diff);
+        }
         let time = self.time(s);
         let m = self.world_from_camera.at(time);
         let world =
@@ -201,6 +323,17 @@ impl Camera {
         )
     }
 
+    /// The ray from the camera's origin along its axis at `time` (a realistic camera's
+    /// stand-in for a vignetted ray where no weight is asked for).
+    fn axis_ray(&self, time: f32) -> Ray {
+        let m = self.world_from_camera.at(time);
+        Ray::new(
+            m.transform_point3(Vec3::ZERO),
+            m.transform_vector3(Vec3::Z).normalize(),
+            time,
+        )
+    }
+
     /// The sample's time within the shutter.
     fn time(&self, s: &CameraSample) -> f32 {
         self.shutter_open + s.time * (self.shutter_close - self.shutter_open)
@@ -214,6 +347,8 @@ impl Camera {
         let (mut o, mut d) = match self.projection {
             Projection::Perspective => (Vec3::ZERO, p_camera.normalize()),
             Projection::Orthographic => (p_camera, Vec3::Z),
+            // Traced through the lens system by `realistic_ray` instead.
+            Projection::Realistic => (Vec3::ZERO, Vec3::Z),
             Projection::Environment => {
                 let theta = std::f32::consts::PI * film.y / self.resolution.1;
                 let phi = 2.0 * std::f32::consts::PI * film.x / self.resolution.0;
@@ -238,6 +373,95 @@ impl Camera {
     }
 }
 
+/// The realistic camera's lens system: `lensfile` read relative to the scene's directory,
+/// `aperturediameter` (mm), `focusdistance` (m), `simpleweighting`, for the film's diagonal.
+/// A missing or malformed file is an error at the directive (with the file's line), a
+/// nonsensical number at its parameter.
+fn lens_system(
+    desc: &CameraDesc,
+    context: &CameraContext,
+    warnings: &mut Vec<acr_parser::Warning>,
+) -> Result<LensSystem> {
+    let p = &desc.plugin;
+    let params = &p.params;
+    let at = |name: &str| params.get(name).map_or(&p.loc, |x| &x.loc).clone();
+    let Some(name) = params.string("lensfile")?.filter(|n| !n.is_empty()) else {
+        return Err(Error::at(
+            &p.loc,
+            "camera \"realistic\" needs a \"string lensfile\" (a lens description file)",
+        ));
+    };
+    let path = context.dir.join(name);
+    let rows = realistic::read_lens_file(&path).map_err(|e| Error::at(&at("lensfile"), e))?;
+    let aperture = params.float_or("aperturediameter", 1.0)? as f32;
+    if !(aperture.is_finite() && aperture > 0.0) {
+        return Err(Error::at(
+            &at("aperturediameter"),
+            format!("aperturediameter {aperture} is not a positive diameter (mm)"),
+        ));
+    }
+    let focus = params.float_or("focusdistance", 10.0)? as f32;
+    if !(focus.is_finite() && focus > 0.0) {
+        return Err(Error::at(
+            &at("focusdistance"),
+            format!("focusdistance {focus} is not a positive distance (m)"),
+        ));
+    }
+    let diagonal = context.film_diagonal_mm;
+    if !(diagonal.is_finite() && diagonal > 0.0) {
+        return Err(Error::at(
+            &p.loc,
+            format!("the film's diagonal {diagonal} mm is not a positive length"),
+        ));
+    }
+    let simple = params.bool_or("simpleweighting", true)?;
+    let mut clamped = None;
+    let lens = LensSystem::new(
+        &rows,
+        aperture,
+        focus,
+        diagonal * 0.001,
+        simple,
+        1024 * 1024,
+        &mut clamped,
+    )
+    .map_err(|e| match e {
+        LensError::NoParaxialRay => Error::at(
+            &at("aperturediameter"),
+            format!(
+                "no ray passes through the lens system of \"{}\" (is the aperture stop too \
+                 small?)",
+                path.display()
+            ),
+        ),
+        LensError::TooClose(d) => Error::at(
+            &at("focusdistance"),
+            format!(
+                "focusdistance {d} m is too close for the lens of \"{}\" to focus",
+                path.display()
+            ),
+        ),
+    })?;
+    if let Some(max) = clamped {
+        warnings.push(acr_parser::Warning::at(
+            &at("aperturediameter"),
+            format!(
+                "aperturediameter {aperture} mm is greater than the stop's {max} mm; clamped \
+                 to it (as pbrt-v3)"
+            ),
+        ));
+    }
+    if simple {
+        // pbrt-v3 warns on every realistic camera with simple weighting (its default).
+        warnings.push(acr_parser::Warning::at(
+            &p.loc,
+            "\"simpleweighting\" weights rays relative to the film's centre: images need not \
+             match other cameras' and vary a bit with the aperture (as pbrt-v3 warns)",
+        ));
+    }
+    Ok(lens)
+}
+
 /// Refuses what pbrt-v3 would take and render nothing sensible from: an empty, inverted or
 /// non-finite screen window (an all-black image), a frame aspect ratio that is not positive
 /// (the window it makes is empty), a negative or non-finite lens radius, a focal distance
@@ -257,8 +481,9 @@ fn check_degenerate(
         let loc = params.get(name).map_or(&p.loc, |x| &x.loc);
         Err(Error::at(loc, why))
     };
-    // The environment camera covers the sphere whatever its window (as pbrt-v3's).
-    if projection != Projection::Environment {
+    // The environment camera covers the sphere whatever its window (as pbrt-v3's); the
+    // realistic camera's film is its diagonal, not a window.
+    if !matches!(projection, Projection::Environment | Projection::Realistic) {
         if params.get("screenwindow").is_none() && !(frame.is_finite() && frame > 0.0) {
             return refuse(
                 "frameaspectratio",
@@ -471,14 +696,114 @@ mod tests {
     }
 
     #[test]
-    fn realistic_and_unknown_cameras_are_located_errors() {
-        for (kind, says) in [("realistic", "lens-system"), ("fisheye", "not supported")] {
-            let d =
-                acr_parser::parse_str(&format!("Camera \"{kind}\""), Path::new("c.pbrt")).unwrap();
-            let e =
-                Camera::new(d.camera.as_ref().unwrap(), (8, 8), glam::DMat4::IDENTITY).unwrap_err();
-            assert!(e.to_string().contains(says), "{e}");
-            assert!(e.to_string().contains("c.pbrt:1:1"), "{e}");
+    fn unknown_cameras_are_located_errors() {
+        let d = acr_parser::parse_str("Camera \"fisheye\"", Path::new("c.pbrt")).unwrap();
+        let e = Camera::new(d.camera.as_ref().unwrap(), (8, 8), glam::DMat4::IDENTITY).unwrap_err();
+        assert!(e.to_string().contains("not supported"), "{e}");
+        assert!(e.to_string().contains("c.pbrt:1:1"), "{e}");
+    }
+
+    /// A directory holding the double-Gauss lens file and a malformed one.
+    /// (`tag` keeps tests running at once apart.)
+    fn lens_dir(tag: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("acr-lens-{}-{tag}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("dgauss.dat"),
+            include_str!("../scenes/pbrt-v3/lenses/dgauss.50mm.dat"),
+        )
+        .unwrap();
+        std::fs::write(dir.join("bad.dat"), "# a lens\n30 4 1.6 20\n0 nan 0 10\n").unwrap();
+        dir
+    }
+
+    fn realistic(params: &str, tag: &str) -> Result<Camera> {
+        let dir = lens_dir(tag);
+        let text = format!("Camera \"realistic\" {params}");
+        let d = acr_parser::parse_str(&text, &dir.join("c.pbrt")).unwrap();
+        Camera::new(d.camera.as_ref().unwrap(), (32, 32), glam::DMat4::IDENTITY)
+    }
+
+    #[test]
+    fn bad_realistic_cameras_are_located_errors() {
+        let cases = [
+            ("", "needs a \"string lensfile\"", "c.pbrt:1:1:"),
+            (
+                "\"string lensfile\" \"nope.dat\"",
+                "cannot read lens file",
+                "c.pbrt:1:20:",
+            ),
+            (
+                "\"string lensfile\" \"bad.dat\"",
+                "line 3: NaN is not a finite",
+                "c.pbrt:1:20:",
+            ),
+            (
+                "\"string lensfile\" \"dgauss.dat\" \"float aperturediameter\" 0",
+                "aperturediameter 0 is not a positive diameter",
+                "c.pbrt:1:",
+            ),
+            (
+                "\"string lensfile\" \"dgauss.dat\" \"float aperturediameter\" -2",
+                "aperturediameter -2 is not a positive diameter",
+                "c.pbrt:1:",
+            ),
+            (
+                "\"string lensfile\" \"dgauss.dat\" \"float focusdistance\" 0.01",
+                "too close for the lens",
+                "c.pbrt:1:",
+            ),
+        ];
+        for (params, says, at) in cases {
+            let e = realistic(params, "bad")
+                .err()
+                .unwrap_or_else(|| panic!("{params}: accepted"));
+            let e = e.to_string();
+            assert!(e.contains(says), "{params}: {e}");
+            assert!(e.contains(at), "{params}: {e}");
         }
+    }
+
+    #[test]
+    fn the_realistic_camera_weighs_its_rays_and_moves() {
+        let c = realistic(
+            "\"string lensfile\" \"dgauss.dat\" \"float aperturediameter\" 8 \
+             \"float focusdistance\" 3",
+            "good",
+        )
+        .unwrap();
+        assert!(c.uses_lens());
+        let s = CameraSample {
+            film: Vec2::new(16.0, 16.0),
+            lens: Vec2::splat(0.5),
+            time: 0.0,
+        };
+        let (ray, diff, w) = c.weighted_ray(&s, true).unwrap();
+        assert!((w - 1.0).abs() < 1e-4, "{w}");
+        // pbrt-v3's camera looks down +z; the lens inverts the image.
+        assert!(ray.d.z > 0.99, "{}", ray.d);
+        let diff = diff.unwrap();
+        // The lens inverts the image onto the film: the raster's axes point the perspective
+        // camera's ways (right is camera +x, down is camera -y).
+        assert!(diff.rx_d.x > ray.d.x, "{diff:?}");
+        assert!(diff.ry_d.y < ray.d.y, "{diff:?}");
+        // Without differentials, the same ray.
+        let (same, none, w2) = c.weighted_ray(&s, false).unwrap();
+        assert!(none.is_none() && w2 == w && same.d == ray.d);
+        // A moving camera carries its lens along.
+        let dir = lens_dir("good");
+        let text = "ActiveTransform StartTime Translate 0 0 0 ActiveTransform EndTime \
+                    Translate 1 0 0 ActiveTransform All \
+                    Camera \"realistic\" \"string lensfile\" \"dgauss.dat\"";
+        let d = acr_parser::parse_str(text, &dir.join("c.pbrt")).unwrap();
+        let c = Camera::new(d.camera.as_ref().unwrap(), (32, 32), glam::DMat4::IDENTITY).unwrap();
+        assert!(c.is_moving());
+        let at = |time| {
+            c.weighted_ray(&CameraSample { time, ..s }, false)
+                .unwrap()
+                .0
+                .o
+        };
+        assert!(((at(1.0) - at(0.0)).length() - 1.0).abs() < 1e-3);
     }
 }

@@ -1,5 +1,7 @@
 //! Integrators: `path` (unidirectional path tracing with light and BSDF sampling combined by
-//! multiple importance sampling, and Russian roulette as pbrt-v3) and `directlighting`.
+//! multiple importance sampling, and Russian roulette as pbrt-v3), `directlighting`, and
+//! pbrt-v3's `ambientocclusion` and `whitted` (`src/integrator/ao.rs`,
+//! `src/integrator/whitted.rs`).
 //!
 //! The path integrator follows pbrt-v3's PathIntegrator in what it estimates, with one change
 //! in how: the BSDF sample that continues the path also serves as the BSDF half of the MIS pair
@@ -19,9 +21,12 @@ use crate::stream::{SampleSource, SampleStream};
 use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
+mod ao;
 pub mod mlt;
 mod subsurface;
 mod volpath;
+mod whitted;
+pub use ao::AoSettings;
 pub use mlt::MltSettings;
 pub use volpath::VolPathSettings;
 
@@ -60,6 +65,13 @@ pub enum Integrator {
         max_depth: u32,
         /// Light sampling strategy.
         strategy: DirectStrategy,
+    },
+    /// `ambientocclusion` (pbrt-v3's AOIntegrator).
+    AmbientOcclusion(AoSettings),
+    /// `whitted` (pbrt-v3's WhittedIntegrator).
+    Whitted {
+        /// Specular recursion depth.
+        max_depth: u32,
     },
 }
 
@@ -154,6 +166,42 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
         build: Integrator::direct,
     },
     mlt::ENTRY,
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "ambientocclusion",
+            doc: "ambient occlusion at the first hit: pi times the unoccluded fraction of the hemisphere (pbrt-v3 ambientocclusion)",
+            params: &[
+                ParamSpec::new(
+                    "nsamples",
+                    ParamType::Integer,
+                    "64",
+                    "hemisphere directions traced at each camera ray's hit",
+                ),
+                ParamSpec::new(
+                    "cossample",
+                    ParamType::Bool,
+                    "true",
+                    "cosine-weighted directions (else uniform over the hemisphere)",
+                ),
+            ],
+        },
+        build: Integrator::ambient_occlusion,
+    },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "whitted",
+            doc: "Whitted ray tracing: every light sampled once, specular reflection and refraction followed (pbrt-v3 whitted)",
+            params: &[ParamSpec::new(
+                "maxdepth",
+                ParamType::Integer,
+                "5",
+                "specular recursion depth",
+            )],
+        },
+        build: Integrator::whitted,
+    },
 ];
 
 /// `maxdepth`, which must not be negative.
@@ -221,6 +269,31 @@ impl Integrator {
         })
     }
 
+    /// `ambientocclusion` from its parameters (pbrt-v3's defaults: nsamples 64, cossample
+    /// true); fewer than one sample is refused (pbrt-v3 renders black).
+    pub fn ambient_occlusion(c: &Choice) -> Result<Self> {
+        let params = &c.params;
+        let n = params.int_or("nsamples", 64)?;
+        let samples = u32::try_from(n).ok().filter(|&n| n > 0).ok_or_else(|| {
+            let message = format!("nsamples {n} is not a positive count of directions");
+            match params.get("nsamples") {
+                Some(p) => Error::at(&p.loc, message),
+                None => Error::file("nsamples", message),
+            }
+        })?;
+        Ok(Integrator::AmbientOcclusion(AoSettings {
+            samples,
+            cos_sample: params.bool_or("cossample", true)?,
+        }))
+    }
+
+    /// `whitted` from its parameters (pbrt-v3's default: maxdepth 5).
+    pub fn whitted(c: &Choice) -> Result<Self> {
+        Ok(Integrator::Whitted {
+            max_depth: max_depth(&c.params)?,
+        })
+    }
+
     /// The name, as the stats file reports it.
     pub fn name(&self) -> &'static str {
         match self {
@@ -228,6 +301,8 @@ impl Integrator {
             Integrator::VolPath(_) => "volpath",
             Integrator::Mlt(_) => "mlt",
             Integrator::Direct { .. } => "directlighting",
+            Integrator::AmbientOcclusion(_) => "ambientocclusion",
+            Integrator::Whitted { .. } => "whitted",
         }
     }
 
@@ -280,6 +355,16 @@ impl Integrator {
             } => {
                 let mut tally = Tally::default();
                 let l = direct_li(scene, ray, diff, stream, max_depth, 0, strategy, &mut tally);
+                Radiance {
+                    l,
+                    rays: tally.rays,
+                    first_hit: tally.probe.features(),
+                }
+            }
+            Integrator::AmbientOcclusion(settings) => ao::ao_li(scene, ray, stream, settings),
+            Integrator::Whitted { max_depth } => {
+                let mut tally = Tally::default();
+                let l = whitted::whitted_li(scene, ray, diff, stream, max_depth, 0, &mut tally);
                 Radiance {
                     l,
                     rays: tally.rays,

@@ -301,8 +301,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, sppm, ambientocclusion -> \
-         path (bdpt and mlt -> volpath on a scene with media), whitted -> directlighting.\n",
+         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, sppm -> path (bdpt and mlt -> \
+         volpath on a scene with media).\n",
     );
     out
 }

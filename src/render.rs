@@ -456,14 +456,16 @@ impl Tracer<'_, '_> {
                     time: q.time,
                 };
                 let li = self.li;
-                let r = if scene.uses_differentials {
-                    let (ray, diff) = scene.camera.generate_ray_differential(&sample);
-                    let diff = diff.scaled(&ray, diff_scale);
-                    li(scene, ray, Some(&diff), &mut stream)
-                } else {
-                    li(scene, scene.camera.generate_ray(&sample), None, &mut stream)
+                // A sample the realistic camera's lens vignettes counts, black (pbrt-v3).
+                let Some((ray, diff, weight)) =
+                    scene.camera.weighted_ray(&sample, scene.uses_differentials)
+                else {
+                    return (Spectrum::ZERO, 0, Default::default());
                 };
-                (r.l, r.rays, r.first_hit)
+                let diff = diff.map(|d| d.scaled(&ray, diff_scale));
+                let r = li(scene, ray, diff.as_ref(), &mut stream);
+                // Every camera but the realistic one weighs 1: x * 1 is x, images unchanged.
+                (r.l * weight, r.rays, r.first_hit)
             })
             .collect_into_vec(results);
     }

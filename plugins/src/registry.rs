@@ -104,8 +104,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Sampler, "maxmindist", "sobol"),
     (Kind::Integrator, "bdpt", "path"),
     (Kind::Integrator, "sppm", "path"),
-    (Kind::Integrator, "ambientocclusion", "path"),
-    (Kind::Integrator, "whitted", "directlighting"),
 ];
 
 /// Finds the plugin called `name` among `entries` (of kind `kind`). A pbrt-v3 name acr lacks

@@ -348,7 +348,21 @@ impl Scene {
         let camera_desc = camera_of(desc)?;
         let film = FilmSettings::new(desc.film.as_ref())?;
         let render_from_world = render_from_world(camera_desc)?;
-        let camera = Camera::new(camera_desc, film.resolution, render_from_world)?;
+        let diagonal = match &desc.film {
+            Some(f) => f.params.float_or("diagonal", 35.0)? as f32,
+            None => 35.0,
+        };
+        let context = crate::camera::CameraContext {
+            film_diagonal_mm: diagonal,
+            dir: &main_dir,
+        };
+        let camera = Camera::with_context(
+            camera_desc,
+            film.resolution,
+            render_from_world,
+            &context,
+            warnings,
+        )?;
         let mut b = Builder::new(desc, warnings, render_from_world);
         let accel = b.accel()?;
         let (lo, hi) = accel.bounds();
@@ -369,7 +383,7 @@ impl Scene {
         let dims = Dims {
             time: (accel.has_motion() || camera.is_moving())
                 && camera.shutter_close > camera.shutter_open,
-            lens: camera.lens_radius > 0.0,
+            lens: camera.uses_lens(),
         };
         Ok(Scene {
             camera,

@@ -1,0 +1,119 @@
+//! `whitted`: pbrt-v3's WhittedIntegrator. Emission at the hit, one light sample from every
+//! light (no MIS: a light is only found by sampling it), and specular reflection and
+//! transmission followed recursively to `maxdepth`, the camera ray's differentials carried
+//! through them (docs/light-transport.md).
+
+use super::{specular_differentials, Tally, MAX_PASS_THROUGH};
+use crate::geometry::{Ray, RayDifferentials, Spectrum};
+use crate::scene::Scene;
+use crate::stream::SampleStream;
+
+/// The radiance along `ray` by Whitted's recursion; `depth` counts specular bounces.
+pub fn whitted_li(
+    scene: &Scene,
+    ray: Ray,
+    diff: Option<&RayDifferentials>,
+    stream: &mut SampleStream,
+    max_depth: u32,
+    depth: u32,
+    tally: &mut Tally,
+) -> Spectrum {
+    let mut ray = ray;
+    let mut pass_through = 0;
+    // A surface without material passes the ray on at the same depth, without emission, as
+    // pbrt-v3's recursion does.
+    let hit = loop {
+        tally.rays += 1;
+        let hit = scene.intersect(&ray);
+        if let Some(h) = &hit {
+            tally.probe.travel(ray.o, h.si.p);
+        }
+        match hit {
+            None => {
+                return scene
+                    .infinite_lights
+                    .iter()
+                    .map(|&i| scene.lights[i as usize].le(ray.d.normalize()))
+                    .sum();
+            }
+            Some(h) if h.surface.material.is_none() => {
+                pass_through += 1;
+                if pass_through > MAX_PASS_THROUGH {
+                    return Spectrum::ZERO;
+                }
+                ray = h.si.spawn_ray(ray.d);
+            }
+            Some(h) => break h,
+        }
+    };
+    let mut si = hit.si;
+    // The differentials hold for the ray as it left the camera or a specular bounce.
+    let camera_diff = diff.filter(|_| pass_through == 0);
+    if let Some(d) = camera_diff {
+        si.compute_differentials(d);
+    }
+    // pbrt-v3 takes the cosine against the shading normal before bump mapping changes it.
+    let n = si.shading_n;
+    let mut l = Spectrum::ZERO;
+    if let Some(li) = hit.surface.area_light {
+        l += scene.lights[li as usize].l(&si, si.wo);
+    }
+    let Some(material) = hit.surface.material else {
+        return l;
+    };
+    let material = &scene.materials[material as usize];
+    let si = material.shading(&si);
+    // Separate lobes (a glass's reflection and transmission apart), as pbrt-v3's Whitted.
+    let bsdf = material.bsdf_with(&si, false);
+    tally.probe.surface(&si, &bsdf);
+    // A purely specular BSDF is black to every light sample: pbrt-v3 draws them for nothing.
+    if bsdf.has_non_specular() {
+        for light in &scene.lights {
+            let u = stream.next_2d();
+            let Some(ls) = light.sample_li(&scene.accel.world, si.p, u) else {
+                continue;
+            };
+            if ls.pdf == 0.0 || ls.li == Spectrum::ZERO {
+                continue;
+            }
+            let f = bsdf.f(si.wo, ls.wi);
+            if f == Spectrum::ZERO {
+                continue;
+            }
+            tally.rays += 1;
+            if !scene.occluded(&si, ls.p) {
+                l += f * ls.li * ls.wi.dot(n).abs() / ls.pdf;
+            }
+        }
+    }
+    // pbrt-v3's SpecularReflect and SpecularTransmit: each specular lobe, its own sample.
+    if depth + 1 < max_depth {
+        for index in 0..bsdf.num_lobes() {
+            let u = stream.next_2d();
+            let Some(s) = bsdf.sample_specular_lobe(si.wo, u, index) else {
+                continue;
+            };
+            let cos = s.wi.dot(si.shading_n).abs();
+            let weight = s.f * cos / s.pdf;
+            if cos == 0.0 || weight == Spectrum::ZERO || !crate::geometry::is_valid_radiance(weight)
+            {
+                continue;
+            }
+            let next = si.spawn_ray(s.wi);
+            let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
+            let next_diff =
+                camera_diff.map(|d| specular_differentials(d, &si, s.wi, transmitted, bsdf.eta()));
+            l += weight
+                * whitted_li(
+                    scene,
+                    next,
+                    next_diff.as_ref(),
+                    stream,
+                    max_depth,
+                    depth + 1,
+                    tally,
+                );
+        }
+    }
+    l
+}
