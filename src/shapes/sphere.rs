@@ -3,10 +3,11 @@
 
 use super::coordinate_system;
 use super::quadric::{
-    nearest_root, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, world_area,
+    nearest_root, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, quadric_normal,
+    world_area,
 };
 use super::Transform;
-use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
+use crate::geometry::{Crossing, Ray, SurfaceInteraction, Vec2, Vec3};
 use crate::sampling::uniform_sample_sphere;
 use std::f32::consts::PI;
 
@@ -47,6 +48,17 @@ pub struct SphereHit {
     pub p: Vec3,
     /// Its azimuth in [0, 2 pi), or -1 where not computed yet (full spheres).
     pub phi: f32,
+}
+
+/// The sphere's tangents at a point and the angles they come from.
+struct SphereTangents {
+    theta: f32,
+    /// thetaMax - thetaMin.
+    dtheta: f32,
+    cos_phi: f32,
+    sin_phi: f32,
+    dpdu: Vec3,
+    dpdv: Vec3,
 }
 
 impl Sphere {
@@ -163,18 +175,12 @@ impl Sphere {
         let p = hit.p;
         let phi = if hit.phi < 0.0 { phi_of(p) } else { hit.phi };
         let u = phi / self.phi_max;
-        let theta = (p.z / self.radius).clamp(-1.0, 1.0).acos();
-        let dtheta = self.theta_max - self.theta_min;
-        let v = (theta - self.theta_min) / dtheta;
-        let z_radius = (p.x * p.x + p.y * p.y).sqrt();
-        let cos_phi = p.x / z_radius;
-        let sin_phi = p.y / z_radius;
-        let dpdu = Vec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0);
-        let dpdv = dtheta * Vec3::new(p.z * cos_phi, p.z * sin_phi, -self.radius * theta.sin());
-        let pm = self.phi_max;
+        let t = self.tangents(p);
+        let v = (t.theta - self.theta_min) / t.dtheta;
+        let (pm, dtheta) = (self.phi_max, t.dtheta);
         let second = [
             -pm * pm * Vec3::new(p.x, p.y, 0.0),
-            dtheta * p.z * pm * Vec3::new(-sin_phi, cos_phi, 0.0),
+            dtheta * p.z * pm * Vec3::new(-t.sin_phi, t.cos_phi, 0.0),
             -dtheta * dtheta * p,
         ];
         quadric_interaction(
@@ -183,10 +189,41 @@ impl Sphere {
             ray,
             p,
             Vec2::new(u, v),
-            dpdu,
-            dpdv,
+            t.dpdu,
+            t.dpdv,
             Some(second),
         )
+    }
+
+    /// The point and normal of a hit, as [`Sphere::interaction`] computes them, without its
+    /// (u, v) (an atan2), the normal's derivatives or the tangents in world space.
+    #[inline]
+    pub fn crossing(&self, ray: &Ray, hit: &SphereHit) -> Crossing {
+        let t = self.tangents(hit.p);
+        Crossing {
+            p: self.object_to_world.point(hit.p),
+            n: quadric_normal(&self.object_to_world, self.flip, t.dpdu, t.dpdv),
+            p_error: 0.0,
+            time: ray.time,
+        }
+    }
+
+    /// pbrt-v3's dp/du and dp/dv at object-space point `p` and the angles they come from.
+    #[inline]
+    fn tangents(&self, p: Vec3) -> SphereTangents {
+        let theta = (p.z / self.radius).clamp(-1.0, 1.0).acos();
+        let dtheta = self.theta_max - self.theta_min;
+        let z_radius = (p.x * p.x + p.y * p.y).sqrt();
+        let cos_phi = p.x / z_radius;
+        let sin_phi = p.y / z_radius;
+        SphereTangents {
+            theta,
+            dtheta,
+            cos_phi,
+            sin_phi,
+            dpdu: Vec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0),
+            dpdv: dtheta * Vec3::new(p.z * cos_phi, p.z * sin_phi, -self.radius * theta.sin()),
+        }
     }
 
     /// pbrt-v3's `Area()`: the object-space area phimax r (zmax - zmin).
