@@ -308,8 +308,8 @@ impl SurfaceInteraction {
 
 /// Where a ray meets a surface, with only what spawning the ray that goes on needs: a ray
 /// crossing an interface surface (`Material ""`) or a probe ray passing other surfaces needs
-/// no (u, v), tangents or shading frame (docs/media.md). The same values, bit for bit, as the
-/// full [`SurfaceInteraction`]'s.
+/// no (u, v), tangents or shading frame (docs/media.md). The full [`SurfaceInteraction`]'s
+/// values (on spheres the normal to a few ulps).
 #[derive(Clone, Copy, Debug)]
 pub struct Crossing {
     /// The hit point.

@@ -2,8 +2,9 @@
 //! the error bound of a hit, which is all a ray continuing through an interface surface
 //! (`Material ""`) or a probe ray passing other surfaces needs (docs/media.md). Spheres and
 //! triangles skip their (u, v), tangents, normal derivatives and shading frame; the other
-//! shapes, rare as interfaces, take the full interaction's values. Bit for bit the full
-//! interaction's point and normal, so that images do not change.
+//! shapes, rare as interfaces, take the full interaction's values. The point is the full
+//! interaction's bit for bit, the normal too except on spheres (p / r there, equal to a few
+//! ulps: images move by float rounding only, docs/media.md).
 
 use super::{local_ray, world_normal, world_p_error, Accel, Geometry, Hit, LocalHit, PrimKind};
 use crate::geometry::{Crossing, Ray};
