@@ -282,6 +282,57 @@ impl SurfaceInteraction {
         }
     }
 
+    /// What spawning a ray from the point needs (its point, normal, error bound and time).
+    #[inline]
+    pub fn crossing(&self) -> Crossing {
+        Crossing {
+            p: self.p,
+            n: self.n,
+            p_error: self.p_error,
+            time: self.time,
+        }
+    }
+
+    /// A ray leaving the surface along `d`, its origin offset to the side `d` points to.
+    #[inline]
+    pub fn spawn_ray(&self, d: Vec3) -> Ray {
+        self.crossing().spawn_ray(d)
+    }
+
+    /// A shadow ray towards `target` and the parameter just short of it (for t in (0, tmax)).
+    #[inline]
+    pub fn spawn_ray_to(&self, target: Vec3) -> (Ray, f32) {
+        self.crossing().spawn_ray_to(target)
+    }
+}
+
+/// Where a ray meets a surface, with only what spawning the ray that goes on needs: a ray
+/// crossing an interface surface (`Material ""`) or a probe ray passing other surfaces needs
+/// no (u, v), tangents or shading frame (docs/media.md). The full [`SurfaceInteraction`]'s
+/// values (on spheres the normal to a few ulps).
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    /// The hit point.
+    pub p: Vec3,
+    /// Unit geometric normal, oriented as [`SurfaceInteraction::n`].
+    pub n: Vec3,
+    /// The point's error bound ([`SurfaceInteraction::p_error`]).
+    pub p_error: f32,
+    /// The ray's time.
+    pub time: f32,
+}
+
+impl Crossing {
+    /// The geometric normal flipped to the side of `w`.
+    #[inline]
+    fn n_towards(&self, w: Vec3) -> Vec3 {
+        if self.n.dot(w) < 0.0 {
+            -self.n
+        } else {
+            self.n
+        }
+    }
+
     /// A ray leaving the surface along `d`, its origin offset to the side `d` points to.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {

@@ -20,6 +20,7 @@ use obvhs::BvhBuildParams;
 use rayon::prelude::*;
 use std::time::Duration;
 
+mod crossing;
 mod wide;
 
 /// What a BVH leaf primitive is, and the surface (material, area light) it carries.
@@ -558,12 +559,7 @@ fn transform_interaction(
     to_local: &Mat4,
     world_ray: &Ray,
 ) -> SurfaceInteraction {
-    let normal = |n: Vec3| {
-        to_local
-            .transpose()
-            .transform_vector3(n)
-            .normalize_or_zero()
-    };
+    let normal = |n: Vec3| world_normal(to_local, n);
     SurfaceInteraction {
         p: to_world.transform_point3(si.p),
         n: normal(si.n),
@@ -578,15 +574,30 @@ fn transform_interaction(
         dndv: to_local.transpose().transform_vector3(si.dndv),
         wo: -world_ray.d.normalize(),
         time: si.time,
-        p_error: si.p_error
-            * to_world
-                .x_axis
-                .truncate()
-                .length()
-                .max(to_world.y_axis.truncate().length())
-                .max(to_world.z_axis.truncate().length()),
+        p_error: world_p_error(to_world, si.p_error),
         diff: si.diff,
     }
+}
+
+/// An instance-space normal in the world (by the inverse transpose), normalised.
+#[inline]
+fn world_normal(to_local: &Mat4, n: Vec3) -> Vec3 {
+    to_local
+        .transpose()
+        .transform_vector3(n)
+        .normalize_or_zero()
+}
+
+/// An instance-space error bound in the world: scaled by the transform's longest axis.
+#[inline]
+fn world_p_error(to_world: &Mat4, p_error: f32) -> f32 {
+    p_error
+        * to_world
+            .x_axis
+            .truncate()
+            .length()
+            .max(to_world.y_axis.truncate().length())
+            .max(to_world.z_axis.truncate().length())
 }
 
 #[cfg(test)]

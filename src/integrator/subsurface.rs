@@ -6,8 +6,9 @@
 //! sample of that BSDF. Kept apart from `path` so that `volpath` can call it too.
 
 use super::{next_event, LastScatter, MAX_PASS_THROUGH};
+use crate::accel::Hit;
 use crate::bssrdf::{adapter_bsdf, TabulatedBssrdf};
-use crate::geometry::{is_valid_radiance, Ray, Spectrum, SurfaceInteraction};
+use crate::geometry::{is_valid_radiance, Ray, Spectrum, SurfaceInteraction, Vec3};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -39,32 +40,34 @@ pub(super) fn find_exit(
     let u2 = stream.next_2d();
     let probe = bssrdf.probe(u1, u2)?;
     // Every surface of the same material along the segment (pbrt-v3 compares material
-    // pointers; acr's materials are indices). Other surfaces are crossed.
-    let mut found: Vec<(SurfaceInteraction, u32)> = Vec::new();
+    // pointers; acr's materials are indices). Other surfaces are crossed. Only the chosen
+    // one's full interaction is computed; the probe needs just each hit's point and normal.
+    let mut found = Candidates::default();
     let mut ray = Ray::new(probe.start, probe.end - probe.start, time);
     let mut t_max = 1.0 - crate::geometry::SHADOW_EPSILON;
     for _ in 0..MAX_PASS_THROUGH {
-        if ray.d == crate::geometry::Vec3::ZERO {
+        if ray.d == Vec3::ZERO {
             break;
         }
         *rays += 1;
         let Some(hit) = scene.accel.intersect(&ray, t_max) else {
             break;
         };
-        let si = scene.accel.interaction(&ray, &hit);
-        (ray, t_max) = si.spawn_ray_to(probe.end);
+        let c = scene.accel.crossing(&ray, &hit);
         if scene.surfaces[hit.prim.surface as usize].material == Some(material) {
-            found.push((si, hit.prim.surface));
+            found.push(Candidate {
+                hit,
+                ray,
+                p: c.p,
+                n: c.n,
+            });
         }
-    }
-    if found.is_empty() {
-        return None;
+        (ray, t_max) = c.spawn_ray_to(probe.end);
     }
     let n = found.len();
-    let chosen = ((probe.u_choice * n as f32) as usize).min(n - 1);
-    let (mut pi, surface) = found[chosen];
-    let pdf = bssrdf.pdf_sp(pi.p, pi.n) / n as f32;
-    let sp = bssrdf.sp(pi.p);
+    let chosen = found.get(((probe.u_choice * n as f32) as usize).min(n.max(1) - 1))?;
+    let pdf = bssrdf.pdf_sp(chosen.p, chosen.n) / n as f32;
+    let sp = bssrdf.sp(chosen.p);
     if sp == Spectrum::ZERO || pdf.is_nan() || pdf <= 0.0 {
         return None;
     }
@@ -72,9 +75,59 @@ pub(super) fn find_exit(
     if !is_valid_radiance(*beta) {
         return None;
     }
+    let mut si = scene.accel.interaction(&chosen.ray, &chosen.hit);
     // pbrt-v3's `Sample_S`: the exit point looks out along its shading normal.
-    pi.wo = pi.shading_n;
-    Some(Exit { si: pi, surface })
+    si.wo = si.shading_n;
+    Some(Exit {
+        si,
+        surface: chosen.hit.prim.surface,
+    })
+}
+
+/// A probe segment's hit on the entry's material: the hit and the ray that found it (for the
+/// full interaction, computed for the chosen one only), its point and geometric normal.
+#[derive(Clone, Copy)]
+struct Candidate {
+    hit: Hit,
+    ray: Ray,
+    p: Vec3,
+    n: Vec3,
+}
+
+/// How many candidates [`Candidates`] keeps without allocating: a convex surface gives two.
+const INLINE_CANDIDATES: usize = 8;
+
+/// The candidates along one probe segment: the first few in place, the rest (a segment through
+/// a folded surface) on the heap, so that the common case allocates nothing.
+#[derive(Default)]
+struct Candidates {
+    inline: [Option<Candidate>; INLINE_CANDIDATES],
+    len: usize,
+    spill: Vec<Candidate>,
+}
+
+impl Candidates {
+    fn push(&mut self, c: Candidate) {
+        match self.inline.get_mut(self.len) {
+            Some(slot) => *slot = Some(c),
+            None => self.spill.push(c),
+        }
+        self.len += 1;
+    }
+
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn get(&self, i: usize) -> Option<Candidate> {
+        if i >= self.len {
+            return None;
+        }
+        match self.inline.get(i) {
+            Some(slot) => *slot,
+            None => self.spill.get(i - INLINE_CANDIDATES).copied(),
+        }
+    }
 }
 
 /// Follows a path that entered material `material` (whose BSSRDF at the entry point is

@@ -238,6 +238,67 @@ fn medium_tr(
     }
 }
 
+/// Where a ray that crosses interface surfaces goes on from each: along its own direction, or
+/// (a shadow ray) towards a fixed point.
+#[derive(Clone, Copy)]
+enum Toward {
+    Along,
+    Point(Vec3),
+}
+
+/// Follows `mr` up to `t_max` through interface surfaces (`Material ""`), each of which may
+/// change the medium, and gives the first surface with a material (with the ray that found
+/// it) and the transmittance up to it, or up to `t_max` when there is none. A shadow ray
+/// (`Toward::Point`) stops with zero transmittance at a blocking surface, before measuring the
+/// medium, and as soon as the transmittance is zero (pbrt-v3's `VisibilityTester::Tr`); a
+/// ray `Toward::Along` measures on (pbrt-v3's `Scene::IntersectTr`). The crossings need only
+/// the point and normal ([`crate::accel::Accel::crossing`]).
+fn cross_interfaces(
+    scene: &Scene,
+    mut mr: MediumRay,
+    mut t_max: f32,
+    toward: Toward,
+    stream: &mut SampleStream,
+    rays: &mut u32,
+) -> (Option<(RawHit, Ray)>, Spectrum) {
+    let shadow = matches!(toward, Toward::Point(_));
+    let mut tr = Spectrum::ONE;
+    for _ in 0..MAX_PASS_THROUGH {
+        *rays += 1;
+        let hit = intersect(scene, &mr.ray, t_max);
+        if let Some(h) = hit.filter(|h| shadow && h.surface.material.is_some()) {
+            return (Some((h, mr.ray)), Spectrum::ZERO);
+        }
+        let t_end = hit.map_or(t_max, |h| h.hit.t);
+        tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
+        let Some(h) = hit else {
+            return (None, tr);
+        };
+        if h.surface.material.is_some() {
+            return (Some((h, mr.ray)), tr);
+        }
+        if shadow && tr == Spectrum::ZERO {
+            return (None, tr);
+        }
+        let c = scene.accel.crossing(&mr.ray, &h.hit);
+        let media = media_at(&h.surface, mr.medium);
+        (mr, t_max) = match toward {
+            Toward::Along => {
+                let d = mr.ray.d;
+                let medium = media.toward(c.n, d);
+                let ray = c.spawn_ray(d);
+                (MediumRay { ray, medium }, f32::INFINITY)
+            }
+            Toward::Point(target) => {
+                let (ray, t) = c.spawn_ray_to(target);
+                let medium = media.toward(c.n, ray.d);
+                (MediumRay { ray, medium }, t)
+            }
+        };
+    }
+    (None, Spectrum::ZERO)
+}
+
 /// pbrt-v3's `VisibilityTester::Tr`: the transmittance from `from` to `target`, zero when a
 /// surface with a material blocks it; interface surfaces are crossed, changing the medium.
 fn transmittance_to(
@@ -247,31 +308,11 @@ fn transmittance_to(
     stream: &mut SampleStream,
     rays: &mut u32,
 ) -> Spectrum {
-    let (mut mr, mut t_max) = from.spawn_to(target);
-    let mut tr = Spectrum::ONE;
-    for _ in 0..MAX_PASS_THROUGH {
-        *rays += 1;
-        let hit = intersect(scene, &mr.ray, t_max);
-        if hit.is_some_and(|h| h.surface.material.is_some()) {
-            return Spectrum::ZERO;
-        }
-        let t_end = hit.map_or(t_max, |h| h.hit.t);
-        tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
-        let Some(h) = hit else {
-            return tr;
-        };
-        if tr == Spectrum::ZERO {
-            return tr;
-        }
-        let si = scene.accel.interaction(&mr.ray, &h.hit);
-        let (ray, t) = si.spawn_ray_to(target);
-        mr = MediumRay {
-            medium: media_at(&h.surface, mr.medium).toward(si.n, ray.d),
-            ray,
-        };
-        t_max = t;
+    let (mr, t_max) = from.spawn_to(target);
+    match cross_interfaces(scene, mr, t_max, Toward::Point(target), stream, rays) {
+        (Some(_), _) => Spectrum::ZERO,
+        (None, tr) => tr,
     }
-    Spectrum::ZERO
 }
 
 /// pbrt-v3's `Scene::IntersectTr`: the first surface with a material along `mr`, crossing
@@ -279,30 +320,11 @@ fn transmittance_to(
 /// when none is found).
 fn intersect_tr(
     scene: &Scene,
-    mut mr: MediumRay,
+    mr: MediumRay,
     stream: &mut SampleStream,
     rays: &mut u32,
 ) -> (Option<(RawHit, Ray)>, Spectrum) {
-    let mut tr = Spectrum::ONE;
-    for _ in 0..MAX_PASS_THROUGH {
-        *rays += 1;
-        let hit = intersect(scene, &mr.ray, f32::INFINITY);
-        let t_end = hit.map_or(f32::INFINITY, |h| h.hit.t);
-        tr *= medium_tr(scene, mr.medium, &mr.ray, t_end, stream);
-        let Some(h) = hit else {
-            return (None, tr);
-        };
-        if h.surface.material.is_some() {
-            return (Some((h, mr.ray)), tr);
-        }
-        let si = scene.accel.interaction(&mr.ray, &h.hit);
-        let d = mr.ray.d;
-        mr = MediumRay {
-            medium: media_at(&h.surface, mr.medium).toward(si.n, d),
-            ray: si.spawn_ray(d),
-        };
-    }
-    (None, Spectrum::ZERO)
+    cross_interfaces(scene, mr, f32::INFINITY, Toward::Along, stream, rays)
 }
 
 /// pbrt-v3's `EstimateDirect` with media: a light sample with the transmittance to it, and
@@ -451,6 +473,29 @@ pub(super) fn volpath_li(
             mr = v.spawn(s.wi);
             specular_bounce = false;
         } else {
+            // An interface that emits nothing: the ray goes on in the same direction (not a
+            // bounce), from the point and normal alone.
+            if let Some(h) = hit
+                .filter(|h| h.surface.material.is_none())
+                .filter(|h| h.surface.area_light.is_none())
+            {
+                if bounces >= settings.max_depth {
+                    break;
+                }
+                // The camera ray's differentials end at the first surface, as below.
+                diff = None;
+                let c = scene.accel.crossing(&mr.ray, &h.hit);
+                probe.travel(mr.ray.o, c.p);
+                pass_through += 1;
+                if pass_through > MAX_PASS_THROUGH {
+                    break;
+                }
+                mr = MediumRay {
+                    medium: media_at(&h.surface, mr.medium).toward(c.n, mr.ray.d),
+                    ray: c.spawn_ray(mr.ray.d),
+                };
+                continue;
+            }
             let hit = hit.map(|h| h.resolve(scene, &mr.ray));
             if bounces == 0 || specular_bounce {
                 l += beta * emission(scene, hit.as_ref(), mr.ray.d);

@@ -90,10 +90,8 @@ pub(crate) fn quadric_interaction(
     dpdv: Vec3,
     second: Option<[Vec3; 3]>,
 ) -> SurfaceInteraction {
-    let n_obj = dpdu.cross(dpdv).normalize_or(Vec3::Z);
     let (dndu, dndv) = second.map_or((Vec3::ZERO, Vec3::ZERO), |d2| weingarten(dpdu, dpdv, d2));
-    let n_obj = if flip { -n_obj } else { n_obj };
-    let n = to_world.normal(n_obj).normalize_or(n_obj);
+    let n = quadric_normal(to_world, flip, dpdu, dpdv);
     let dpdu_w = to_world.vector(dpdu);
     SurfaceInteraction {
         p: to_world.point(p_obj),
@@ -111,6 +109,15 @@ pub(crate) fn quadric_interaction(
         p_error: 0.0,
         diff: Default::default(),
     }
+}
+
+/// A quadric's world-space unit normal, as [`quadric_interaction`] orients it: normalize(dpdu x
+/// dpdv) flipped when `flip`, carried to world space by the inverse transpose.
+#[inline]
+pub(crate) fn quadric_normal(to_world: &Transform, flip: bool, dpdu: Vec3, dpdv: Vec3) -> Vec3 {
+    let n_obj = dpdu.cross(dpdv).normalize_or(Vec3::Z);
+    let n_obj = if flip { -n_obj } else { n_obj };
+    to_world.normal(n_obj).normalize_or(n_obj)
 }
 
 /// dn/du and dn/dv of the unit normal normalize(dpdu x dpdv) from the surface's first and

@@ -3,10 +3,11 @@
 
 use super::coordinate_system;
 use super::quadric::{
-    nearest_root, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, world_area,
+    nearest_root, phi_max_radians, phi_of, quadratic_roots, quadric_interaction, quadric_normal,
+    world_area,
 };
 use super::Transform;
-use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
+use crate::geometry::{Crossing, Ray, SurfaceInteraction, Vec2, Vec3};
 use crate::sampling::uniform_sample_sphere;
 use std::f32::consts::PI;
 
@@ -47,6 +48,17 @@ pub struct SphereHit {
     pub p: Vec3,
     /// Its azimuth in [0, 2 pi), or -1 where not computed yet (full spheres).
     pub phi: f32,
+}
+
+/// The sphere's tangents at a point and the angles they come from.
+struct SphereTangents {
+    theta: f32,
+    /// thetaMax - thetaMin.
+    dtheta: f32,
+    cos_phi: f32,
+    sin_phi: f32,
+    dpdu: Vec3,
+    dpdv: Vec3,
 }
 
 impl Sphere {
@@ -132,6 +144,15 @@ impl Sphere {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, SphereHit)> {
         let o = self.object_to_world.inv_point(ray.o);
         let d = self.object_to_world.inv_vector(ray.d);
+        if self.clearly_missed(o, d) {
+            return None;
+        }
+        self.intersect_object(o, d, t_max)
+    }
+
+    /// [`Sphere::intersect`] for the object-space ray `o + t d`, without the early miss test.
+    #[inline]
+    fn intersect_object(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, SphereHit)> {
         let (od, dd) = (o.as_dvec3(), d.as_dvec3());
         let r = self.radius as f64;
         let a = dd.length_squared();
@@ -150,6 +171,21 @@ impl Sphere {
         })
     }
 
+    /// Whether the line through object-space `o` along `d` passes so far from the sphere that
+    /// the exact test below must find no root: a test in f32 without division or square root,
+    /// which most rays that reach a sphere's box and miss it take. Its margin, 10^-5 of
+    /// |o|^2 |d|^2, is 16 times the rounding error of the f32 expression (a few ulps of that
+    /// product), so it rejects only lines whose squared distance from the centre exceeds r^2
+    /// by more than both tests' errors: the same result as the f64 test, never a lost hit.
+    #[inline]
+    fn clearly_missed(&self, o: Vec3, d: Vec3) -> bool {
+        let (oo, dd, od) = (o.dot(o), d.dot(d), o.dot(d));
+        let r2 = self.radius * self.radius;
+        // |d|^2 times the squared distance from the centre to the line, minus r^2 |d|^2.
+        let excess = (oo * dd - od * od) - r2 * dd;
+        excess > 1e-5 * (oo * dd) && (oo * dd).is_finite()
+    }
+
     /// Any-hit variant of [`Sphere::intersect`].
     #[inline]
     pub fn intersect_p(&self, ray: &Ray, t_max: f32) -> bool {
@@ -163,18 +199,12 @@ impl Sphere {
         let p = hit.p;
         let phi = if hit.phi < 0.0 { phi_of(p) } else { hit.phi };
         let u = phi / self.phi_max;
-        let theta = (p.z / self.radius).clamp(-1.0, 1.0).acos();
-        let dtheta = self.theta_max - self.theta_min;
-        let v = (theta - self.theta_min) / dtheta;
-        let z_radius = (p.x * p.x + p.y * p.y).sqrt();
-        let cos_phi = p.x / z_radius;
-        let sin_phi = p.y / z_radius;
-        let dpdu = Vec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0);
-        let dpdv = dtheta * Vec3::new(p.z * cos_phi, p.z * sin_phi, -self.radius * theta.sin());
-        let pm = self.phi_max;
+        let t = self.tangents(p);
+        let v = (t.theta - self.theta_min) / t.dtheta;
+        let (pm, dtheta) = (self.phi_max, t.dtheta);
         let second = [
             -pm * pm * Vec3::new(p.x, p.y, 0.0),
-            dtheta * p.z * pm * Vec3::new(-sin_phi, cos_phi, 0.0),
+            dtheta * p.z * pm * Vec3::new(-t.sin_phi, t.cos_phi, 0.0),
             -dtheta * dtheta * p,
         ];
         quadric_interaction(
@@ -183,10 +213,52 @@ impl Sphere {
             ray,
             p,
             Vec2::new(u, v),
-            dpdu,
-            dpdv,
+            t.dpdu,
+            t.dpdv,
             Some(second),
         )
+    }
+
+    /// The point and normal of a hit without the (u, v) (an atan2), tangents (an acos and a
+    /// sine) or normal derivatives of [`Sphere::interaction`]: dp/du x dp/dv is -phimax
+    /// (thetaMax - thetaMin) r sin(theta) p, outward wherever the sphere is not degenerate
+    /// (thetaMin > thetaMax, phimax > 0), so the object-space normal is p / r, oriented and
+    /// carried to world space as the interaction's. It equals the interaction's normal to a
+    /// few ulps, not bit for bit (docs/media.md).
+    #[inline]
+    pub fn crossing(&self, ray: &Ray, hit: &SphereHit) -> Crossing {
+        let n = if self.phi_max > 0.0 && self.theta_min > self.theta_max {
+            let n_obj = hit.p.normalize_or(Vec3::Z);
+            let n_obj = if self.flip { -n_obj } else { n_obj };
+            self.object_to_world.normal(n_obj).normalize_or(n_obj)
+        } else {
+            let t = self.tangents(hit.p);
+            quadric_normal(&self.object_to_world, self.flip, t.dpdu, t.dpdv)
+        };
+        Crossing {
+            p: self.object_to_world.point(hit.p),
+            n,
+            p_error: 0.0,
+            time: ray.time,
+        }
+    }
+
+    /// pbrt-v3's dp/du and dp/dv at object-space point `p` and the angles they come from.
+    #[inline]
+    fn tangents(&self, p: Vec3) -> SphereTangents {
+        let theta = (p.z / self.radius).clamp(-1.0, 1.0).acos();
+        let dtheta = self.theta_max - self.theta_min;
+        let z_radius = (p.x * p.x + p.y * p.y).sqrt();
+        let cos_phi = p.x / z_radius;
+        let sin_phi = p.y / z_radius;
+        SphereTangents {
+            theta,
+            dtheta,
+            cos_phi,
+            sin_phi,
+            dpdu: Vec3::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0),
+            dpdv: dtheta * Vec3::new(p.z * cos_phi, p.z * sin_phi, -self.radius * theta.sin()),
+        }
     }
 
     /// pbrt-v3's `Area()`: the object-space area phimax r (zmax - zmin).
@@ -342,6 +414,65 @@ mod tests {
             .intersect(&Ray::new(Vec3::new(-10.0, 1.01, 0.0), Vec3::X, 0.0), 1e9)
             .is_none());
         close(s.area(), 4.0 * PI, 1e-5);
+    }
+
+    #[test]
+    fn crossing_matches_the_interaction() {
+        // Full, cut, reversed and transformed (handedness-swapping) spheres: the crossing's
+        // point is the interaction's bit for bit, its normal the same to a few ulps.
+        let m = Mat4::from_translation(Vec3::new(0.3, -1.0, 2.0))
+            * Mat4::from_rotation_y(0.4)
+            * Mat4::from_scale(Vec3::new(1.5, -0.8, 1.1));
+        let spheres = [
+            unit(),
+            Sphere::new(1.0, -0.4, 0.9, 250.0, Transform::IDENTITY, true),
+            Sphere::new(0.6, -0.6, 0.6, 360.0, Transform::new(m), false),
+        ];
+        let mut checked = 0;
+        for s in &spheres {
+            for i in 0..300 {
+                let f = i as f32;
+                let o = Vec3::new((f * 0.3).sin(), (f * 0.7).cos(), (f * 0.11).sin()) * 6.0;
+                let target = Vec3::new(0.3, -1.0, 2.0) * (i % 3) as f32 * 0.5;
+                let ray = Ray::new(o, target - o + Vec3::splat((f * 0.9).sin() * 0.3), 0.0);
+                let Some((t, h)) = s.intersect(&ray, f32::INFINITY) else {
+                    continue;
+                };
+                let (si, c) = (s.interaction(&ray, t, &h), s.crossing(&ray, &h));
+                assert_eq!(c.p, si.p);
+                close3(c.n, si.n, 1e-5);
+                checked += 1;
+            }
+        }
+        assert!(checked > 100, "{checked}");
+    }
+
+    #[test]
+    fn early_miss_test_never_loses_a_hit() {
+        // Lines at distances from the centre around r, from near and far origins, in many
+        // directions: where the f32 test says "missed", the exact test finds no root; and it
+        // does reject clear misses (else it would save nothing).
+        let s = Sphere::new(0.7, -0.7, 0.7, 360.0, Transform::IDENTITY, false);
+        let (mut rejected, mut kept_hits) = (0, 0);
+        for i in 0..4000 {
+            let f = i as f32;
+            let d = Vec3::new((f * 0.37).sin(), (f * 0.61).cos(), (f * 0.13).sin() + 0.1)
+                .normalize()
+                * (0.5 + (f * 0.07).sin().abs() * 3.0);
+            let (a, _) = crate::shapes::coordinate_system(d.normalize());
+            // Distance from the centre: 0.7 (1 + e), e from -1e-3 to 1e-3 and a few clear ones.
+            let e = ((i % 41) as f32 - 20.0) * 5e-5 + if i % 7 == 0 { 0.5 } else { 0.0 };
+            let back = [1.0, 30.0, 1e3, 1e5][i % 4];
+            let o = a * 0.7 * (1.0 + e) - d.normalize() * back;
+            let exact = s.intersect_object(o, d, f32::INFINITY);
+            if s.clearly_missed(o, d) {
+                assert!(exact.is_none(), "lost a hit: o {o} d {d}");
+                rejected += 1;
+            } else if exact.is_some() {
+                kept_hits += 1;
+            }
+        }
+        assert!(rejected > 500 && kept_hits > 500, "{rejected} {kept_hits}");
     }
 
     #[test]

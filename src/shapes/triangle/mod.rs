@@ -2,7 +2,7 @@
 //! its triangle differential geometry, shading normals and area sampling.
 
 use super::{coordinate_system, faceforward, Transform};
-use crate::geometry::{Ray, SurfaceInteraction, Vec2, Vec3};
+use crate::geometry::{Crossing, Ray, SurfaceInteraction, Vec2, Vec3};
 use crate::sampling::uniform_sample_triangle;
 
 mod intersect;
@@ -130,10 +130,8 @@ pub fn shading_normal(mesh: &TriangleMesh, tri: usize, b: [f32; 3]) -> Option<Ve
 }
 
 /// The full interaction of a triangle hit, as pbrt-v3's `Triangle::Intersect` builds it:
-/// dp/du and dp/dv from the uvs; geometric normal normalize((p0 - p2) x (p1 - p2)); with vertex
-/// normals, the shading frame from the interpolated normal (tangent: dp/du orthogonalised against it and, as pbrt-v3 computes it, negated) and
-/// the geometric normal flipped into the shading normal's hemisphere; without them, the normal
-/// flipped when ReverseOrientation xor the transform swaps handedness.
+/// dp/du and dp/dv from the uvs; geometric normal normalize((p0 - p2) x (p1 - p2)), oriented and
+/// with its shading frame as [`shading_geometry`] gives them.
 pub fn triangle_interaction(
     mesh: &TriangleMesh,
     tri: usize,
@@ -146,29 +144,9 @@ pub fn triangle_interaction(
     let (dpdu, dpdv) = triangle_dpduv(&p, &uv);
     let p_hit = b0 * p[0] + b1 * p[1] + b2 * p[2];
     let uv_hit = b0 * uv[0] + b1 * uv[1] + b2 * uv[2];
-    let mut n = (p[0] - p[2]).cross(p[1] - p[2]).normalize();
-
-    let (shading_n, shading_dpdu, shading_dpdv) = if mesh.normals.is_some() {
-        let ns = shading_normal(mesh, tri, [b0, b1, b2]).unwrap_or(n);
-        let mut ss = dpdu.normalize();
-        let mut ts = ss.cross(ns);
-        if ts.length_squared() > 0.0 {
-            ts = ts.normalize();
-            ss = ts.cross(ns);
-        } else {
-            (ss, ts) = coordinate_system(ns);
-        }
-        // SetShadingGeometry(ss, ts, .., orientationIsAuthoritative = true).
-        let sn = ss.cross(ts).normalize();
-        n = faceforward(n, sn);
-        (sn, ss, ts)
-    } else {
-        if mesh.reverse_orientation ^ mesh.transform_swaps_handedness {
-            n = -n;
-        }
-        (n, dpdu, dpdv)
-    };
-
+    let n = (p[0] - p[2]).cross(p[1] - p[2]).normalize();
+    let (n, shading_n, shading_dpdu, shading_dpdv) =
+        shading_geometry(mesh, tri, [b0, b1, b2], n, dpdu, dpdv);
     SurfaceInteraction {
         p: p_hit,
         n,
@@ -184,6 +162,72 @@ pub fn triangle_interaction(
         time: ray.time,
         p_error: 0.0,
         diff: Default::default(),
+    }
+}
+
+/// The oriented geometric normal and the shading frame (normal, dp/du, dp/dv) at barycentrics
+/// `b` from the unoriented geometric normal `n` and the tangents: with vertex normals, the frame
+/// from the interpolated normal (tangent: dp/du orthogonalised against it and, as pbrt-v3
+/// computes it, negated) and `n` flipped into its hemisphere; without them, `n` flipped when
+/// ReverseOrientation xor the transform swaps handedness.
+#[inline]
+fn shading_geometry(
+    mesh: &TriangleMesh,
+    tri: usize,
+    b: [f32; 3],
+    n: Vec3,
+    dpdu: Vec3,
+    dpdv: Vec3,
+) -> (Vec3, Vec3, Vec3, Vec3) {
+    if mesh.normals.is_some() {
+        let ns = shading_normal(mesh, tri, b).unwrap_or(n);
+        let mut ss = dpdu.normalize();
+        let mut ts = ss.cross(ns);
+        if ts.length_squared() > 0.0 {
+            ts = ts.normalize();
+            ss = ts.cross(ns);
+        } else {
+            (ss, ts) = coordinate_system(ns);
+        }
+        // SetShadingGeometry(ss, ts, .., orientationIsAuthoritative = true).
+        let sn = ss.cross(ts).normalize();
+        (faceforward(n, sn), sn, ss, ts)
+    } else {
+        let n = if mesh.reverse_orientation ^ mesh.transform_swaps_handedness {
+            -n
+        } else {
+            n
+        };
+        (n, n, dpdu, dpdv)
+    }
+}
+
+/// The point and oriented geometric normal of a triangle hit, as [`triangle_interaction`]
+/// computes them; on a mesh without vertex normals, without its (u, v) or tangents.
+#[inline]
+pub fn triangle_crossing(
+    mesh: &TriangleMesh,
+    tri: usize,
+    ray: &Ray,
+    hit: &TriangleHit,
+) -> Crossing {
+    let p = mesh.vertices(tri);
+    let p_hit = hit.b0 * p[0] + hit.b1 * p[1] + hit.b2 * p[2];
+    let n = (p[0] - p[2]).cross(p[1] - p[2]).normalize();
+    let n = if mesh.normals.is_some() {
+        // The orientation follows the shading frame, which needs the tangents.
+        let (dpdu, dpdv) = triangle_dpduv(&p, &mesh.uvs_of(tri));
+        shading_geometry(mesh, tri, [hit.b0, hit.b1, hit.b2], n, dpdu, dpdv).0
+    } else if mesh.reverse_orientation ^ mesh.transform_swaps_handedness {
+        -n
+    } else {
+        n
+    };
+    Crossing {
+        p: p_hit,
+        n,
+        p_error: 0.0,
+        time: ray.time,
     }
 }
 
