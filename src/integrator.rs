@@ -19,6 +19,7 @@ use crate::stream::SampleStream;
 use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
+pub mod sppm;
 mod subsurface;
 mod volpath;
 pub use volpath::VolPathSettings;
@@ -57,6 +58,9 @@ pub enum Integrator {
         /// Light sampling strategy.
         strategy: DirectStrategy,
     },
+    /// `sppm`: stochastic progressive photon mapping; it drives its own sampling
+    /// ([`sppm::render`]).
+    Sppm(sppm::SppmSettings),
 }
 
 /// What one camera sample's estimate produced.
@@ -149,6 +153,15 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
         },
         build: Integrator::direct,
     },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "sppm",
+            doc: "stochastic progressive photon mapping: visible points, photons from the lights, shrinking radii (pbrt-v3 sppm)",
+            params: sppm::PARAMS,
+        },
+        build: |c| Ok(Integrator::Sppm(sppm::SppmSettings::from_choice(c)?)),
+    },
 ];
 
 /// `maxdepth`, which must not be negative.
@@ -222,6 +235,7 @@ impl Integrator {
             Integrator::Path { .. } => "path",
             Integrator::VolPath(_) => "volpath",
             Integrator::Direct { .. } => "directlighting",
+            Integrator::Sppm(_) => "sppm",
         }
     }
 
@@ -251,6 +265,17 @@ impl Integrator {
             Integrator::VolPath(settings) => {
                 volpath::volpath_li(scene, ray, diff, stream, settings)
             }
+            // sppm renders whole images ([`sppm::render`]); a caller that asks it for one
+            // camera sample's estimate gets the path integrator's.
+            Integrator::Sppm(s) => path_li(
+                scene,
+                ray,
+                diff,
+                stream,
+                s.max_depth,
+                1.0,
+                LightStrategy::Power,
+            ),
             Integrator::Direct {
                 max_depth,
                 strategy,

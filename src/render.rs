@@ -227,6 +227,9 @@ pub fn render_with_features(
     progress: Option<&indicatif::ProgressBar>,
     features: Option<&mut FeatureImage>,
 ) -> RenderCounts {
+    if let Integrator::Sppm(settings) = integrator {
+        return crate::integrator::sppm::render(scene, settings, film, seed, stop, progress);
+    }
     let li = |scene: &Scene,
               ray: Ray,
               diff: Option<&RayDifferentials>,

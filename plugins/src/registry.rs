@@ -104,7 +104,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Sampler, "maxmindist", "sobol"),
     (Kind::Integrator, "bdpt", "path"),
     (Kind::Integrator, "mlt", "path"),
-    (Kind::Integrator, "sppm", "path"),
     (Kind::Integrator, "ambientocclusion", "path"),
     (Kind::Integrator, "whitted", "directlighting"),
 ];

@@ -4,6 +4,7 @@
 use super::pipeline::{self, Row};
 use super::RenderArgs;
 use crate::registry::{choose_for_scene, Overrides, Plugins};
+use crate::integrator::{sppm, Integrator};
 use crate::scene::Scene;
 use acr_parser::{SceneDescription, Warning};
 use acr_plugins::Setting;
@@ -66,6 +67,12 @@ impl Job {
             choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
                 .map_err(|e| e.to_string())?;
         start_at_sample_offset(args.sample_offset, &mut plugins)?;
+        if matches!(plugins.integrator, Integrator::Sppm(_)) {
+            let threshold = args.noise_threshold.is_some();
+            if let Some(why) = sppm::refuse(plugins.sampler.as_ref(), threshold) {
+                return Err(why);
+            }
+        }
         scene.set_footprint_spp(footprint_spp(args, plugins.sampler.spp()));
         let splats = plugins.filter.cell_layout().is_none() && !plugins.sampler.reconstructs();
         if args.mergeable && (!splats || plugins.sampler.streams() > 1) {

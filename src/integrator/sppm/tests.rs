@@ -1,0 +1,1 @@
+//! sppm's tests: settings, the grid, the per-pixel update.
