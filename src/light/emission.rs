@@ -43,7 +43,10 @@ pub fn sample_le(scene: &Scene, light: &Light, u1: Vec2, u2: Vec2, time: f32) ->
         } => {
             let wl = uniform_sample_cone(u1, *cos_total);
             // A rotation: its transpose takes light space back to world space.
-            let d = light_from_world.transpose().transform_vector3(wl).normalize();
+            let d = light_from_world
+                .transpose()
+                .transform_vector3(wl)
+                .normalize();
             let falloff = spot_falloff(wl.z, *cos_total, *cos_falloff_start);
             point_sample(
                 *pos,

@@ -3,8 +3,8 @@
 
 use super::pipeline::{self, Row};
 use super::RenderArgs;
-use crate::registry::{choose_for_scene, Overrides, Plugins};
 use crate::integrator::{sppm, Integrator};
+use crate::registry::{choose_for_scene, Overrides, Plugins};
 use crate::scene::Scene;
 use acr_parser::{SceneDescription, Warning};
 use acr_plugins::Setting;

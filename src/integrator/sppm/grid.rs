@@ -25,7 +25,9 @@ pub struct Grid {
 /// pbrt-v3's hash of a cell into `size` buckets.
 #[inline]
 fn hash(c: [i32; 3], size: usize) -> usize {
-    let h = c[0].wrapping_mul(73_856_093) ^ c[1].wrapping_mul(19_349_663) ^ c[2].wrapping_mul(83_492_791);
+    let h = c[0].wrapping_mul(73_856_093)
+        ^ c[1].wrapping_mul(19_349_663)
+        ^ c[2].wrapping_mul(83_492_791);
     (h as u32 as usize) % size
 }
 

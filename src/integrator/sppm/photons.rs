@@ -27,9 +27,9 @@ const MAX_PASS_THROUGH: u32 = 256;
 
 /// The first primes: the Halton bases of a photon's dimensions.
 const PRIMES: [u32; 48] = [
-    2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89,
-    97, 101, 103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181,
-    191, 193, 197, 199, 211, 223,
+    2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97,
+    101, 103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181, 191, 193,
+    197, 199, 211, 223,
 ];
 
 /// What one iteration's photons brought to the visible points.
@@ -213,8 +213,7 @@ impl<'s> Shooter<'s> {
         let Some(s) = sample_le(scene, &scene.lights[light], u1, u2, time) else {
             return;
         };
-        let mut beta =
-            s.le * (s.n.dot(s.ray.d).abs() / (light_pdf * s.pdf_pos * s.pdf_dir));
+        let mut beta = s.le * (s.n.dot(s.ray.d).abs() / (light_pdf * s.pdf_pos * s.pdf_dir));
         if !is_valid_radiance(beta) || beta == Spectrum::ZERO {
             return;
         }
