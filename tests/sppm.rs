@@ -183,7 +183,8 @@ fn nonsense_parameters_are_located_errors() {
     }
 }
 
-/// An adaptive sampler is refused with a message that says sppm draws its own samples.
+/// An adaptive sampler and a noise threshold are refused with a message that says sppm draws
+/// its own samples.
 #[test]
 fn adaptive_samplers_are_refused() {
     let overrides = Overrides {
@@ -192,6 +193,17 @@ fn adaptive_samplers_are_refused() {
     };
     let e = choice_error(&small_scene(""), &overrides);
     assert!(e.contains("mdas") && e.contains("sppm"), "{e}");
+    // `--noise-threshold` too (`acr render` asks before it renders); a plain sampler is not.
+    let desc = parse_str(&small_scene(""), Path::new("ok.pbrt")).unwrap();
+    let mut warnings = Vec::new();
+    let scene = Scene::build(&desc, &mut warnings).unwrap();
+    let p = choose_for_scene(&desc, &scene, &Overrides::default(), None, 1, &mut warnings).unwrap();
+    let e = acr::integrator::sppm::refuse(p.sampler.as_ref(), true).unwrap();
+    assert!(e.contains("--noise-threshold") && e.contains("sppm"), "{e}");
+    assert_eq!(
+        acr::integrator::sppm::refuse(p.sampler.as_ref(), false),
+        None
+    );
 }
 
 /// Every light's `sample_le` rays carry its power: the mean of Le |cos| / (pdf_pos pdf_dir)

@@ -48,7 +48,11 @@ pub(super) fn render_scene(
 ) -> Result<Rendered, String> {
     let mut film = job.plugins.film(&job.scene);
     let bar = progress_bar(args.quiet);
-    let spp = job.plugins.sampler.spp();
+    let spp = match &job.plugins.integrator {
+        // sppm draws one camera sample per pixel per iteration, whatever the sampler's budget.
+        crate::integrator::Integrator::Sppm(s) => s.iterations,
+        _ => job.plugins.sampler.spp(),
+    };
     if let Some(t) = args.noise_threshold {
         // An adaptive sampler that can stops where it is settled; the render loop's global
         // check stops any sampler.

@@ -73,13 +73,15 @@ impl Grid {
                     for z in a[2]..=b[2] {
                         for y in a[1]..=b[1] {
                             for x in a[0]..=b[0] {
-                                own.push((hash([x, y, z], buckets) as u32, i as u32));
+                                let e = (hash([x, y, z], buckets) as u32, i as u32);
+                                // Two of its cells in one bucket would count each photon there
+                                // twice (a point spans few cells: a scan is cheapest).
+                                if !own.contains(&e) {
+                                    own.push(e);
+                                }
                             }
                         }
                     }
-                    // Two of its cells in one bucket would count each photon there twice.
-                    own.sort_unstable();
-                    own.dedup();
                 }
                 own
             })

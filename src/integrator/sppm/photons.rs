@@ -67,17 +67,40 @@ fn unit(h: u64) -> f32 {
     (h >> 40) as f32 / (1u64 << 24) as f32
 }
 
-/// The radical inverse of `i` in `base`, below 1.
-fn radical_inverse(base: u32, mut i: u64) -> f32 {
-    let b = u64::from(base);
-    let inv = 1.0 / base as f64;
+/// The radical inverse of `i` in `B`, below 1 (a constant base, so that the divisions are
+/// multiplications, as pbrt-v3's `RadicalInverse` specialises them).
+#[inline]
+fn radical_inverse<const B: u64>(mut i: u64) -> f32 {
+    let inv = 1.0 / B as f64;
     let (mut reversed, mut factor) = (0u64, 1.0f64);
     while i > 0 {
-        reversed = reversed * b + i % b;
+        let next = i / B;
+        reversed = reversed * B + (i - next * B);
         factor *= inv;
-        i /= b;
+        i = next;
     }
     ((reversed as f64 * factor) as f32).min(1.0 - f32::EPSILON / 2.0)
+}
+
+/// The radical inverse of `i` in the `d`-th prime (`d` below `PRIMES.len()`).
+#[inline]
+fn halton(d: usize, i: u64) -> f32 {
+    macro_rules! bases {
+        ($($k:literal => $b:literal),*) => {
+            match d {
+                0 => (i.reverse_bits() >> 11) as f32 * (1.0 / (1u64 << 53) as f32),
+                $($k => radical_inverse::<$b>(i),)*
+                _ => unreachable!("dimension {d} has no prime"),
+            }
+        };
+    }
+    bases!(1 => 3, 2 => 5, 3 => 7, 4 => 11, 5 => 13, 6 => 17, 7 => 19, 8 => 23, 9 => 29,
+        10 => 31, 11 => 37, 12 => 41, 13 => 43, 14 => 47, 15 => 53, 16 => 59, 17 => 61,
+        18 => 67, 19 => 71, 20 => 73, 21 => 79, 22 => 83, 23 => 89, 24 => 97, 25 => 101,
+        26 => 103, 27 => 107, 28 => 109, 29 => 113, 30 => 127, 31 => 131, 32 => 137,
+        33 => 139, 34 => 149, 35 => 151, 36 => 157, 37 => 163, 38 => 167, 39 => 173,
+        40 => 179, 41 => 181, 42 => 191, 43 => 193, 44 => 197, 45 => 199, 46 => 211,
+        47 => 223)
 }
 
 /// A photon's dimensions: Halton at its index, shifted; past the primes, hashed.
@@ -93,9 +116,9 @@ impl Dims<'_> {
     fn next(&mut self) -> f32 {
         let d = self.dim;
         self.dim += 1;
-        match PRIMES.get(d) {
-            Some(&p) => {
-                let v = radical_inverse(p, self.index) + self.shifts[d];
+        match self.shifts.get(d) {
+            Some(&shift) => {
+                let v = halton(d, self.index) + shift;
                 let v = if v >= 1.0 { v - 1.0 } else { v };
                 v.min(1.0 - f32::EPSILON / 2.0)
             }
@@ -289,6 +312,26 @@ impl<'s> Shooter<'s> {
             beta = bnew / (1.0 - q);
             ray = si.spawn_ray(bs.wi);
             depth += 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{halton, PRIMES};
+
+    /// The specialised radical inverses are the plain one of each prime.
+    #[test]
+    fn halton_dimensions_are_the_radical_inverses_of_the_primes() {
+        for (d, &p) in PRIMES.iter().enumerate() {
+            for i in [0u32, 1, 2, 7, 100, 12345, 987_654_321] {
+                let want = crate::lightdistrib::radical_inverse(p, i);
+                let got = halton(d, u64::from(i));
+                assert!(
+                    (got - want).abs() < 1e-6,
+                    "base {p}, index {i}: {got} vs {want}"
+                );
+            }
         }
     }
 }
