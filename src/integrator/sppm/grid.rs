@@ -44,7 +44,7 @@ impl Grid {
                 max_radius = max_radius.max(r);
             }
         }
-        if !(max_radius > 0.0) || !lo.is_finite() || !hi.is_finite() {
+        if max_radius <= 0.0 || !lo.is_finite() || !hi.is_finite() {
             return None;
         }
         let extent = hi - lo;
