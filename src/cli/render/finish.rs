@@ -177,7 +177,10 @@ pub(super) fn report_end(
 /// how to finish it.
 fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> String {
     let spp = rendered.spp;
-    let reached = reached_spp(&rendered.film.pixel_stats());
+    // sppm's image is not made of filtered samples: its camera samples count its iterations.
+    let pixels = rendered.film.pixel_stats().len().max(1) as u64;
+    let sppm_iterations = (rendered.counts.samples / pixels).min(u64::from(u32::MAX)) as u32;
+    let reached = reached_spp(&rendered.film.pixel_stats()).max(sppm_iterations);
     let resume = if target.out.can_merge {
         // The rest's default footprint is this render's unless the command line chose one.
         let footprint = args
