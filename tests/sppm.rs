@@ -255,3 +255,39 @@ fn emitted_rays_carry_the_lights_power() {
         }
     }
 }
+
+/// A spot light's rays carry I times its falloff integrated over the cone:
+/// 2 pi I ((1 - cos_start) + (cos_start - cos_total) / 5) for pbrt-v3's quartic smoothstep
+/// (pbrt-v3's `Power` is an approximation of it, so the exact integral is the yardstick).
+#[test]
+fn spot_rays_carry_the_falloff_integral() {
+    let text = "LookAt 0 1 4  0 0.5 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+        LightSource \"spot\" \"point from\" [0 2 0] \"point to\" [1 0 0.5] \"rgb I\" [3 2 1]\n\
+        \"float coneangle\" 40 \"float conedeltaangle\" 15\n\
+        Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [-3 0 -3  -3 0 3  3 0 3]\n\
+        WorldEnd\n";
+    let desc = parse_str(text, Path::new("spot.pbrt")).unwrap();
+    let scene = Scene::build(&desc, &mut Vec::new()).unwrap();
+    let light = &scene.lights[0];
+    let (n, mut sum) = (256 * 256, Spectrum::ZERO);
+    for k in 0..n {
+        let u1 = Vec2::new(
+            ((k % 256) as f32 + 0.5) / 256.0,
+            ((k / 256) as f32 + 0.5) / 256.0,
+        );
+        if let Some(s) = sample_le(&scene, light, u1, Vec2::splat(0.5), 0.0) {
+            // Inside the cone around the axis from (0 2 0) to (1 0 0.5).
+            let axis = acr::geometry::Vec3::new(1.0, -2.0, 0.5).normalize();
+            assert!(s.ray.d.dot(axis) >= 40f32.to_radians().cos() - 1e-4);
+            sum += s.le * (s.n.dot(s.ray.d).abs() / (s.pdf_pos * s.pdf_dir));
+        }
+    }
+    let (ct, cs) = (40f32.to_radians().cos(), 25f32.to_radians().cos());
+    let want =
+        Spectrum::new(3.0, 2.0, 1.0) * 2.0 * std::f32::consts::PI * ((1.0 - cs) + (cs - ct) / 5.0);
+    let mean = sum / n as f32;
+    assert!(
+        (mean - want).abs().max_element() < 0.005 * want.max_element(),
+        "{mean} vs {want}"
+    );
+}
