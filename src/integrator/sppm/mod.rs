@@ -10,7 +10,7 @@
 //! film's unfiltered splats, one value per pixel at its centre.
 
 use crate::geometry::{Spectrum, Vec2};
-use crate::render::{Halt, RenderCounts, Stop};
+use crate::render::stop::{Halt, RenderCounts, Stop};
 use crate::scene::Scene;
 use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::film::UnfilteredSplats;
