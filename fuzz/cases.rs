@@ -145,6 +145,11 @@ pub fn render(data: &[u8]) {
             settings.chains = settings.chains.min(16);
         }
         Integrator::AmbientOcclusion(settings) => settings.samples = settings.samples.min(8),
+        Integrator::Sppm(s) => {
+            s.max_depth = s.max_depth.min(8);
+            s.iterations = s.iterations.min(2);
+            s.photons_per_iteration = Some(s.photons_per_iteration.unwrap_or(64).min(64));
+        }
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

@@ -23,6 +23,7 @@ use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
 mod ao;
 pub mod mlt;
+pub mod sppm;
 mod subsurface;
 mod volpath;
 mod whitted;
@@ -73,6 +74,9 @@ pub enum Integrator {
         /// Specular recursion depth.
         max_depth: u32,
     },
+    /// `sppm`: stochastic progressive photon mapping; it drives its own sampling
+    /// ([`sppm::render`]).
+    Sppm(sppm::SppmSettings),
 }
 
 /// What one camera sample's estimate produced.
@@ -202,6 +206,15 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
         },
         build: Integrator::whitted,
     },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "sppm",
+            doc: "stochastic progressive photon mapping: visible points, photons from the lights, shrinking radii (pbrt-v3 sppm)",
+            params: sppm::PARAMS,
+        },
+        build: |c| Ok(Integrator::Sppm(sppm::SppmSettings::from_choice(c)?)),
+    },
 ];
 
 /// `maxdepth`, which must not be negative.
@@ -303,6 +316,7 @@ impl Integrator {
             Integrator::Direct { .. } => "directlighting",
             Integrator::AmbientOcclusion(_) => "ambientocclusion",
             Integrator::Whitted { .. } => "whitted",
+            Integrator::Sppm(_) => "sppm",
         }
     }
 
@@ -349,6 +363,20 @@ impl Integrator {
             Integrator::VolPath(settings) => {
                 volpath::volpath_li(scene, ray, diff, stream, settings)
             }
+            // sppm renders whole images ([`sppm::render`]); a caller that asks it for one
+            // camera sample's estimate gets the path integrator's.
+            Integrator::Sppm(ref s) => path_li(
+                scene,
+                ray,
+                diff,
+                stream,
+                PathRange {
+                    min_depth: 0,
+                    max_depth: s.max_depth,
+                    rr_threshold: 1.0,
+                },
+                LightStrategy::Power,
+            ),
             Integrator::Direct {
                 max_depth,
                 strategy,

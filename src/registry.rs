@@ -4,7 +4,7 @@
 
 use crate::geometry::Spectrum;
 use crate::integrator::{Integrator, IntegratorBuild, INTEGRATORS};
-use acr_parser::{Result, SceneDescription, Warning};
+use acr_parser::{Error, Result, SceneDescription, Warning};
 use acr_plugins::cells::CellGrid;
 use acr_plugins::filters::{FilterBuild, SamplerOutput};
 use acr_plugins::registry::{check_params, lookup};
@@ -279,7 +279,20 @@ pub fn choose_for_scene(
         reconstruction_reads_cells: false,
         stream: Default::default(),
     };
-    choose(desc, overrides, setup, warnings)
+    let mut plugins = choose(desc, overrides, setup, warnings)?;
+    if let Integrator::Sppm(s) = &mut plugins.integrator {
+        // sppm draws its own samples: `--spp` is its iteration count (docs/light-transport.md).
+        if let Some(n) = spp {
+            s.iterations = n.max(1);
+        }
+        if let Some(why) = crate::integrator::sppm::refuse(plugins.sampler.as_ref(), false) {
+            return Err(match &desc.integrator {
+                Some(i) => Error::at(&i.loc, why),
+                None => Error::file("sppm", why),
+            });
+        }
+    }
+    Ok(plugins)
 }
 
 /// `acr plugins`: every plugin by kind, with its parameters and defaults, as text.
@@ -301,8 +314,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, sppm -> path (bdpt and mlt -> \
-         volpath on a scene with media).\n",
+         lowdiscrepancy, maxmindist -> sobol; integrator bdpt -> path (bdpt and mlt -> volpath on \
+         a scene with media).\n",
     );
     out
 }

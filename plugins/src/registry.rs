@@ -103,7 +103,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Sampler, "lowdiscrepancy", "sobol"),
     (Kind::Sampler, "maxmindist", "sobol"),
     (Kind::Integrator, "bdpt", "path"),
-    (Kind::Integrator, "sppm", "path"),
 ];
 
 /// Finds the plugin called `name` among `entries` (of kind `kind`). A pbrt-v3 name acr lacks

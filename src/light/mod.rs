@@ -13,6 +13,7 @@ use glam::{DMat4, Mat4};
 use light_image::{goniometric_scale, ImageProjection, LightImage};
 use std::f32::consts::PI;
 
+pub mod emission;
 pub mod light_image;
 
 /// A light sample as seen from a point.

@@ -186,9 +186,12 @@ fn mutations_made(rendered: &Rendered, pixels: usize) -> Option<u32> {
 fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> String {
     let spp = rendered.spp;
     let stats = rendered.film.pixel_stats();
+    // sppm's image is not made of filtered samples: its camera samples count its iterations.
+    let pixels = stats.len().max(1) as u64;
+    let sppm_iterations = (rendered.counts.samples / pixels).min(u64::from(u32::MAX)) as u32;
     let reached = match mutations_made(rendered, stats.len()) {
         Some(m) => m,
-        None => reached_spp(&stats),
+        None => reached_spp(&stats).max(sppm_iterations),
     };
     let resume = if target.out.can_merge {
         // The rest's default footprint is this render's unless the command line chose one.

@@ -3,6 +3,7 @@
 
 use super::pipeline::{self, Row};
 use super::RenderArgs;
+use crate::integrator::{sppm, Integrator};
 use crate::registry::{choose_for_scene, Overrides, Plugins};
 use crate::scene::Scene;
 use acr_parser::{SceneDescription, Warning};
@@ -65,6 +66,18 @@ impl Job {
         let mut plugins =
             choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
                 .map_err(|e| e.to_string())?;
+        if matches!(plugins.integrator, Integrator::Sppm(_)) {
+            let threshold = args.noise_threshold.is_some();
+            if let Some(why) = sppm::refuse(plugins.sampler.as_ref(), threshold) {
+                return Err(why);
+            }
+            if args.mergeable || args.sample_offset != 0 {
+                return Err("--mergeable and --sample-offset do not apply to the sppm \
+                            integrator: its image is not a sum of samples (each iteration \
+                            shrinks every pixel's radius)"
+                    .into());
+            }
+        }
         start_at_sample_offset(args.sample_offset, &mut plugins)?;
         scene.set_footprint_spp(footprint_spp(args, plugins.sampler.spp()));
         let splats = plugins.filter.cell_layout().is_none() && !plugins.sampler.reconstructs();

@@ -52,6 +52,8 @@ pub(super) fn render_scene(
     let spp = match &job.plugins.integrator {
         // What mlt's --spp sets.
         Integrator::Mlt(m) => m.mutations_per_pixel,
+        // sppm draws one camera sample per pixel per iteration, whatever the sampler's budget.
+        Integrator::Sppm(s) => s.iterations,
         _ => job.plugins.sampler.spp(),
     };
     if matches!(job.plugins.integrator, Integrator::Mlt(_)) {

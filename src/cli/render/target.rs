@@ -61,13 +61,14 @@ fn output_of(args: &RenderArgs, job: &Job, path: PathBuf, is_exr: bool) -> Outpu
         size: (w as usize, h as usize),
         scale: film.scale,
         mergeable: args.mergeable,
-        // mlt's image is normalised by its own bootstrap: its ranges do not add up.
+        // mlt's image is normalised by its own bootstrap: its ranges do not add up; sppm's
+        // image is not a sum of samples: nothing to merge.
         can_merge: is_exr
             && job.splats
             && job.plugins.sampler.streams() == 1
             && !matches!(
                 job.plugins.integrator,
-                crate::integrator::Integrator::Mlt(_)
+                crate::integrator::Integrator::Mlt(_) | crate::integrator::Integrator::Sppm(_)
             ),
         offset: args.sample_offset,
         channel_aovs: Vec::new(),

@@ -1,0 +1,137 @@
+//! sppm's grid of visible points (pbrt-v3's hash grid): cells the size of the largest search
+//! radius over the visible points' bounds, each visible point listed in every cell its search
+//! sphere's box overlaps, cells hashed into as many buckets as there are pixels. pbrt-v3 links
+//! the lists by atomic pushes; here the (bucket, pixel) pairs are made in parallel and laid out
+//! bucket by bucket in pixel order, so the layout does not depend on the threads.
+
+use super::visible::VisiblePoint;
+use crate::geometry::Vec3;
+use rayon::prelude::*;
+
+/// The visible points of one iteration, by grid cell.
+pub struct Grid {
+    /// The grid's box, low corner.
+    lo: Vec3,
+    /// Its extent.
+    extent: Vec3,
+    /// Cells along each axis.
+    res: [i32; 3],
+    /// Where each bucket's pixels start in `entries` (one more than the buckets).
+    starts: Vec<u32>,
+    /// Pixel indices, bucket by bucket, ascending within a bucket.
+    entries: Vec<u32>,
+}
+
+/// pbrt-v3's hash of a cell into `size` buckets.
+#[inline]
+fn hash(c: [i32; 3], size: usize) -> usize {
+    let h = c[0].wrapping_mul(73_856_093)
+        ^ c[1].wrapping_mul(19_349_663)
+        ^ c[2].wrapping_mul(83_492_791);
+    (h as u32 as usize) % size
+}
+
+impl Grid {
+    /// The grid of `visible` (one entry per pixel) with each pixel's search radius in `radii`;
+    /// `None` when no pixel has a visible point.
+    pub fn build(visible: &[Option<VisiblePoint>], radii: &[f32]) -> Option<Grid> {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        let mut max_radius = 0.0f32;
+        for (vp, &r) in visible.iter().zip(radii) {
+            if let Some(vp) = vp {
+                lo = lo.min(vp.p - Vec3::splat(r));
+                hi = hi.max(vp.p + Vec3::splat(r));
+                max_radius = max_radius.max(r);
+            }
+        }
+        if max_radius <= 0.0 || !lo.is_finite() || !hi.is_finite() {
+            return None;
+        }
+        let extent = hi - lo;
+        let max_diag = extent.max_element();
+        // pbrt-v3: cells as wide as the largest radius along the longest axis (capped here so
+        // that a tiny radius in a huge scene cannot ask for more cells than an i32 holds).
+        let base = (max_diag / max_radius).floor().clamp(1.0, 1_048_576.0);
+        let res = [0, 1, 2].map(|i| ((base * extent[i] / max_diag) as i32).max(1));
+        let mut grid = Grid {
+            lo,
+            extent,
+            res,
+            starts: Vec::new(),
+            entries: Vec::new(),
+        };
+        let buckets = visible.len().max(1);
+        let pairs: Vec<(u32, u32)> = visible
+            .par_iter()
+            .zip(radii.par_iter())
+            .enumerate()
+            .flat_map_iter(|(i, (vp, &r))| {
+                let mut own: Vec<(u32, u32)> = Vec::new();
+                if let Some(vp) = vp {
+                    let (a, _) = grid.cell(vp.p - Vec3::splat(r));
+                    let (b, _) = grid.cell(vp.p + Vec3::splat(r));
+                    for z in a[2]..=b[2] {
+                        for y in a[1]..=b[1] {
+                            for x in a[0]..=b[0] {
+                                let e = (hash([x, y, z], buckets) as u32, i as u32);
+                                // Two of its cells in one bucket would count each photon there
+                                // twice (a point spans few cells: a scan is cheapest).
+                                if !own.contains(&e) {
+                                    own.push(e);
+                                }
+                            }
+                        }
+                    }
+                }
+                own
+            })
+            .collect();
+        // A counting sort by bucket, stable: each bucket's pixels stay in ascending order.
+        let mut starts = vec![0u32; buckets + 1];
+        for &(b, _) in &pairs {
+            starts[b as usize + 1] += 1;
+        }
+        for b in 0..buckets {
+            starts[b + 1] += starts[b];
+        }
+        let mut fill = starts.clone();
+        let mut entries = vec![0u32; pairs.len()];
+        for &(b, i) in &pairs {
+            entries[fill[b as usize] as usize] = i;
+            fill[b as usize] += 1;
+        }
+        grid.starts = starts;
+        grid.entries = entries;
+        Some(grid)
+    }
+
+    /// pbrt-v3's `ToGrid`: the cell holding `p` (clamped to the grid) and whether `p` is inside.
+    #[inline]
+    fn cell(&self, p: Vec3) -> ([i32; 3], bool) {
+        let mut c = [0i32; 3];
+        let mut inside = true;
+        for i in 0..3 {
+            let offset = if self.extent[i] > 0.0 {
+                (p[i] - self.lo[i]) / self.extent[i]
+            } else {
+                0.0
+            };
+            let v = (self.res[i] as f32 * offset) as i32;
+            inside &= v >= 0 && v < self.res[i];
+            c[i] = v.clamp(0, self.res[i] - 1);
+        }
+        (c, inside)
+    }
+
+    /// The pixels whose visible points may lie within their radius of `p`: those listed in
+    /// `p`'s bucket (none when `p` is outside the grid).
+    #[inline]
+    pub fn candidates(&self, p: Vec3) -> &[u32] {
+        let (c, inside) = self.cell(p);
+        if !inside {
+            return &[];
+        }
+        let b = hash(c, self.starts.len() - 1);
+        &self.entries[self.starts[b] as usize..self.starts[b + 1] as usize]
+    }
+}
