@@ -3,7 +3,8 @@
 //! transmission followed recursively to `maxdepth`, the camera ray's differentials carried
 //! through them (docs/light-transport.md).
 
-use super::{specular_differentials, Tally, MAX_PASS_THROUGH};
+use super::direct::{specular_differentials, Tally};
+use super::MAX_PASS_THROUGH;
 use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::scene::Scene;
 use crate::stream::SampleStream;

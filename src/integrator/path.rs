@@ -1,0 +1,308 @@
+//! `path`: pbrt-v3's PathIntegrator (light and BSDF sampling combined by MIS, Russian
+//! roulette), with the BSDF sample that continues the path serving as the BSDF half of the MIS
+//! pair for the emission it finds (as pbrt-v4). Also what mlt's interim path function traces.
+
+use super::{subsurface, Radiance, MAX_PASS_THROUGH};
+use crate::first_hit::FirstHitProbe;
+use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction, Vec3};
+use crate::lightbvh::LightContext;
+use crate::lightdistrib::LightStrategy;
+use crate::sampling::power_heuristic;
+use crate::scene::Scene;
+use crate::stream::SampleSource;
+
+/// One light sample at `si` with MIS against the BSDF (for non-delta lights): pbrt-v3's
+/// EstimateDirect without its BSDF-sampling half, which the caller's next ray provides.
+#[inline]
+pub(super) fn sample_light(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &crate::bsdf::Bsdf,
+    light_index: u32,
+    choice_pdf: f32,
+    stream: &mut impl SampleSource,
+    rays: &mut u32,
+) -> Spectrum {
+    let light = &scene.lights[light_index as usize];
+    let u = stream.next_2d();
+    let Some(ls) = light.sample_li(&scene.accel.world, si.p, u) else {
+        return Spectrum::ZERO;
+    };
+    if ls.pdf <= 0.0 || ls.li == Spectrum::ZERO {
+        return Spectrum::ZERO;
+    }
+    let f = bsdf.f(si.wo, ls.wi) * ls.wi.dot(si.shading_n).abs();
+    if f == Spectrum::ZERO {
+        return Spectrum::ZERO;
+    }
+    *rays += 1;
+    if scene.occluded(si, ls.p) {
+        return Spectrum::ZERO;
+    }
+    let light_pdf = ls.pdf * choice_pdf;
+    if light.is_delta() {
+        f * ls.li / light_pdf
+    } else {
+        let w = power_heuristic(1.0, light_pdf, 1.0, bsdf.pdf(si.wo, ls.wi));
+        f * ls.li * w / light_pdf
+    }
+}
+
+/// The path's last scattering, as the MIS weight of the emission its next ray finds needs it.
+#[derive(Clone, Copy)]
+pub(super) struct LastScatter {
+    /// Whether the next ray is the camera ray or leaves a specular bounce: no light sample
+    /// could have found what it finds, so its emission counts whole.
+    pub(super) whole: bool,
+    /// The scattering point.
+    pub(super) p: Vec3,
+    /// The BSDF density of the direction taken from it.
+    pub(super) bsdf_pdf: f32,
+    /// Where the light for next-event estimation was chosen there (`None`: none was).
+    pub(super) ctx: Option<LightContext>,
+}
+
+impl LastScatter {
+    /// Emission `le` of light `light` found by the path of throughput `beta`, weighted against
+    /// the light sample at the last scattering, whose density of it `pdf_of_light` gives
+    /// (times the chance of choosing the light).
+    fn weigh(
+        &self,
+        scene: &Scene,
+        strategy: LightStrategy,
+        light: usize,
+        beta: Spectrum,
+        le: Spectrum,
+        pdf_of_light: impl FnOnce() -> f32,
+    ) -> Spectrum {
+        if self.whole {
+            return beta * le;
+        }
+        let choice = self
+            .ctx
+            .map_or(0.0, |ctx| scene.light_choice_pdf(strategy, ctx, light));
+        let light_pdf = choice * pdf_of_light();
+        beta * le * power_heuristic(1.0, self.bsdf_pdf, 1.0, light_pdf)
+    }
+}
+
+/// Next-event estimation at `si` for the lights chosen at `ctx`: a light's sampled direct
+/// radiance; `None` when no light can reach the point (its sample's dimensions are spent all
+/// the same, so that later decisions keep their place in the stream).
+pub(super) fn next_event(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    bsdf: &crate::bsdf::Bsdf,
+    ctx: LightContext,
+    strategy: LightStrategy,
+    stream: &mut impl SampleSource,
+    rays: &mut u32,
+) -> Option<Spectrum> {
+    match scene.choose_light(strategy, ctx, stream.next_1d()) {
+        Some((light_index, choice_pdf)) => Some(sample_light(
+            scene,
+            si,
+            bsdf,
+            light_index as u32,
+            choice_pdf,
+            stream,
+            rays,
+        )),
+        None => {
+            stream.next_2d();
+            None
+        }
+    }
+}
+
+/// Which path lengths `path_li` counts, in scattering vertices (0: emission the camera ray
+/// finds; a light sample at the first hit makes a path of length 1), and how it ends.
+#[derive(Clone, Copy)]
+pub(super) struct PathRange {
+    /// Contributions of shorter paths are traced past but not added.
+    pub(super) min_depth: u32,
+    /// Longest path, in bounces.
+    pub(super) max_depth: u32,
+    /// Russian roulette below this throughput (0: never).
+    pub(super) rr_threshold: f32,
+}
+
+/// The path integrator's estimate of the radiance along `ray`: at each scattering a light
+/// sample and a BSDF sample, emission found weighted by MIS, Russian roulette after depth 3.
+/// Only contributions of lengths in `range` are added (`path` counts from 0; mlt asks for
+/// one length at a time, see [`path_of_depth`]).
+pub(super) fn path_li(
+    scene: &Scene,
+    mut ray: Ray,
+    mut diff: Option<&RayDifferentials>,
+    stream: &mut impl SampleSource,
+    range: PathRange,
+    light_strategy: LightStrategy,
+) -> Radiance {
+    let PathRange {
+        min_depth,
+        max_depth,
+        rr_threshold,
+    } = range;
+    let mut l = Spectrum::ZERO;
+    let mut beta = Spectrum::ONE;
+    let mut rays = 0u32;
+    let mut depth = 0u32;
+    let mut eta_scale = 1.0f32;
+    let mut last = LastScatter {
+        whole: true,
+        p: ray.o,
+        bsdf_pdf: 0.0,
+        ctx: None,
+    };
+    let mut pass_through = 0u32;
+    let have_lights = !scene.lights.is_empty();
+    let mut probe = FirstHitProbe::default();
+    loop {
+        rays += 1;
+        let Some(hit) = scene.intersect(&ray) else {
+            if depth < min_depth {
+                break;
+            }
+            for &i in &scene.infinite_lights {
+                let light = &scene.lights[i as usize];
+                let le = light.le(ray.d.normalize());
+                l += last.weigh(scene, light_strategy, i as usize, beta, le, || {
+                    light.pdf_le(ray.d.normalize())
+                });
+            }
+            break;
+        };
+        let mut si = hit.si;
+        // Only the camera ray has differentials (pbrt-v3's path integrator spawns every later
+        // ray, and the one through an interface, without them).
+        if let Some(d) = diff.take() {
+            si.compute_differentials(d);
+        }
+        probe.travel(ray.o, si.p);
+        if let Some(li) = hit.surface.area_light.filter(|_| depth >= min_depth) {
+            let light = &scene.lights[li as usize];
+            let le = light.l(&si, si.wo);
+            if le != Spectrum::ZERO {
+                l += last.weigh(scene, light_strategy, li as usize, beta, le, || {
+                    light.pdf_area_hit(&scene.accel.world, last.p, si.p, si.n)
+                });
+            }
+        }
+        let Some(material) = hit.surface.material else {
+            // An interface between media: continue in the same direction, same depth.
+            pass_through += 1;
+            if pass_through > MAX_PASS_THROUGH {
+                break;
+            }
+            ray = si.spawn_ray(ray.d);
+            continue;
+        };
+        if depth >= max_depth {
+            break;
+        }
+        let material_index = material;
+        let material = &scene.materials[material as usize];
+        let si = material.shading(&si);
+        let bsdf = material.bsdf(&si);
+        probe.surface(&si, &bsdf);
+        last.ctx = None;
+        if have_lights && bsdf.has_non_specular() {
+            let ctx = LightContext {
+                p: si.p,
+                n: si.shading_n,
+            };
+            last.ctx = Some(ctx);
+            // A light sample here makes a path one longer than this one; a shorter one than
+            // asked for is not traced.
+            if depth + 1 >= min_depth {
+                let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
+                if let Some(direct) = direct {
+                    l += beta * direct;
+                }
+            }
+        }
+        let u_lobe = stream.next_1d();
+        let u = stream.next_2d();
+        let Some(s) = bsdf.sample_f(si.wo, u, u_lobe) else {
+            break;
+        };
+        if s.pdf <= 0.0 || s.f == Spectrum::ZERO {
+            break;
+        }
+        beta *= s.f * s.wi.dot(si.shading_n).abs() / s.pdf;
+        if !crate::geometry::is_valid_radiance(beta) {
+            break;
+        }
+        let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
+        if s.specular && transmitted {
+            let eta = bsdf.eta();
+            eta_scale *= if si.wo.dot(si.n) > 0.0 {
+                eta * eta
+            } else {
+                1.0 / (eta * eta)
+            };
+        }
+        last.whole = s.specular;
+        last.p = si.p;
+        last.bsdf_pdf = if s.specular { 0.0 } else { s.pdf };
+        ray = si.spawn_ray(s.wi);
+        // Transmitted into a subsurface material: the path leaves from an exit point instead.
+        if let Some(bssrdf) = transmitted.then(|| material.bssrdf(&si)).flatten() {
+            // The light sampled at the exit point counts as a path one longer than this one.
+            let mut at_exit = Spectrum::ZERO;
+            let exit = subsurface::scatter(
+                scene,
+                &bssrdf,
+                material_index,
+                si.time,
+                light_strategy,
+                stream,
+                &mut beta,
+                &mut at_exit,
+                &mut last,
+                &mut rays,
+            );
+            if depth + 1 >= min_depth {
+                l += at_exit;
+            }
+            let Some(next) = exit else { break };
+            ray = next;
+        }
+        depth += 1;
+        let rr_beta = beta * eta_scale;
+        let m = rr_beta.max_element();
+        if m < rr_threshold && depth > 3 {
+            let q = (1.0 - m).max(0.05);
+            if stream.next_1d() < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+    }
+    Radiance {
+        l,
+        rays,
+        first_hit: probe.features(),
+    }
+}
+
+/// The part of `path`'s estimate along the camera ray `ray` made by paths of exactly `depth`
+/// scattering vertices, without Russian roulette: summed over depths 0 to `max_depth` it is
+/// `path`'s estimate with that `maxdepth` (without roulette). What mlt's interim path
+/// contribution traces (docs/light-transport.md, `## mlt`).
+pub(crate) fn path_of_depth(
+    scene: &Scene,
+    ray: Ray,
+    diff: Option<&RayDifferentials>,
+    stream: &mut impl SampleSource,
+    depth: u32,
+    light_strategy: LightStrategy,
+) -> Radiance {
+    let range = PathRange {
+        min_depth: depth,
+        max_depth: depth,
+        rr_threshold: 0.0,
+    };
+    path_li(scene, ray, diff, stream, range, light_strategy)
+}
