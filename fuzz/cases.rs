@@ -136,6 +136,7 @@ pub fn render(data: &[u8]) {
             *max_depth = (*max_depth).min(8);
         }
         Integrator::VolPath(settings) => settings.max_depth = settings.max_depth.min(8),
+        Integrator::Bdpt(settings) => settings.max_depth = settings.max_depth.min(8),
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

@@ -9,6 +9,9 @@ use crate::transform::MotionTransform;
 use acr_parser::{CameraDesc, Error, Result};
 use glam::{Mat4, Vec4};
 
+mod importance;
+pub use importance::ImportanceSample;
+
 /// Where on the film, lens and shutter a camera ray starts.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct CameraSample {

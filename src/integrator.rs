@@ -19,8 +19,10 @@ use crate::stream::SampleStream;
 use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
+pub mod bdpt;
 mod subsurface;
 mod volpath;
+pub use bdpt::BdptSettings;
 pub use volpath::VolPathSettings;
 
 /// Most consecutive pass-through surfaces (`Material ""`) a ray may cross before it is
@@ -50,6 +52,8 @@ pub enum Integrator {
     },
     /// `volpath`: path tracing through participating media (docs/media.md).
     VolPath(VolPathSettings),
+    /// `bdpt`: bidirectional path tracing (docs/light-transport.md).
+    Bdpt(BdptSettings),
     /// `directlighting`.
     Direct {
         /// Specular recursion depth.
@@ -130,6 +134,40 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
     Entry {
         info: PluginInfo {
             kind: Kind::Integrator,
+            name: "bdpt",
+            doc: "bidirectional path tracing: every connection of a camera and a light subpath, MIS-weighted; light tracing splatted (pbrt-v3 bdpt)",
+            params: &[
+                ParamSpec::new(
+                    "maxdepth",
+                    ParamType::Integer,
+                    "5",
+                    "longest path, in bounces",
+                ),
+                ParamSpec::new(
+                    "lightsamplestrategy",
+                    ParamType::String,
+                    "bvh",
+                    "how the s = 1 strategy chooses a light (as path: bvh, spatial, power or uniform); light subpaths choose by power (bvh) or by it at the camera",
+                ),
+                ParamSpec::new(
+                    "visualizestrategies",
+                    ParamType::Bool,
+                    "false",
+                    "also write each strategy's unweighted image, bdpt_dDD_sSS_tTT.exr (not yet: a warning)",
+                ),
+                ParamSpec::new(
+                    "visualizeweights",
+                    ParamType::Bool,
+                    "false",
+                    "also write each strategy's weighted image (not yet: a warning)",
+                ),
+            ],
+        },
+        build: Integrator::bdpt,
+    },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
             name: "directlighting",
             doc: "direct lighting plus specular reflection and refraction (pbrt-v3 directlighting)",
             params: &[
@@ -196,6 +234,16 @@ impl Integrator {
         Ok(Integrator::VolPath(path_settings(c)?))
     }
 
+    /// `bdpt` from its parameters (pbrt-v3's defaults: maxdepth 5; the light strategy as
+    /// `path`'s).
+    pub fn bdpt(c: &Choice) -> Result<Self> {
+        let s = path_settings(c)?;
+        Ok(Integrator::Bdpt(BdptSettings {
+            max_depth: s.max_depth,
+            light_strategy: s.light_strategy,
+        }))
+    }
+
     /// `directlighting` from its parameters (pbrt-v3's defaults: maxdepth 5, strategy all).
     pub fn direct(c: &Choice) -> Result<Self> {
         let params = &c.params;
@@ -221,6 +269,7 @@ impl Integrator {
         match self {
             Integrator::Path { .. } => "path",
             Integrator::VolPath(_) => "volpath",
+            Integrator::Bdpt(_) => "bdpt",
             Integrator::Direct { .. } => "directlighting",
         }
     }
@@ -251,6 +300,7 @@ impl Integrator {
             Integrator::VolPath(settings) => {
                 volpath::volpath_li(scene, ray, diff, stream, settings)
             }
+            Integrator::Bdpt(settings) => bdpt::bdpt_li(scene, ray, diff, stream, settings),
             Integrator::Direct {
                 max_depth,
                 strategy,

@@ -271,7 +271,7 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt, mlt, sppm, \
+         lowdiscrepancy, maxmindist -> sobol; integrators mlt, sppm, \
          ambientocclusion -> path (bdpt and mlt -> volpath on a scene with media), whitted -> \
          directlighting.\n",
     );

@@ -102,7 +102,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Sampler, "02sequence", "sobol"),
     (Kind::Sampler, "lowdiscrepancy", "sobol"),
     (Kind::Sampler, "maxmindist", "sobol"),
-    (Kind::Integrator, "bdpt", "path"),
     (Kind::Integrator, "mlt", "path"),
     (Kind::Integrator, "sppm", "path"),
     (Kind::Integrator, "ambientocclusion", "path"),

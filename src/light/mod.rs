@@ -13,7 +13,9 @@ use glam::{DMat4, Mat4};
 use light_image::{goniometric_scale, ImageProjection, LightImage};
 use std::f32::consts::PI;
 
+mod emission;
 pub mod light_image;
+pub use emission::{EmissionSample, WorldSphere};
 
 /// A light sample as seen from a point.
 #[derive(Clone, Copy, Debug)]

@@ -1,0 +1,208 @@
+//! `bdpt`: pbrt-v3's bidirectional path tracer (docs/light-transport.md). Each camera sample
+//! traces a camera subpath and a light subpath and evaluates every connection (s, t) with its
+//! MIS weight; the strategies that reach the camera from the light side (t = 1) land on other
+//! pixels and go to the film as unfiltered splats (see [`take_splats`]).
+//!
+//! The subpaths and the connection are generic over [`SampleSource`], so that mlt drives
+//! them from its own primary sample space.
+
+use crate::first_hit::FirstHitProbe;
+use crate::geometry::{Ray, RayDifferentials, Spectrum, Vec2, Vec3};
+use crate::integrator::Radiance;
+use crate::lightbvh::LightContext;
+use crate::lightdistrib::LightStrategy;
+use crate::scene::Scene;
+use crate::stream::SampleSource;
+use std::cell::RefCell;
+
+mod connect;
+mod mis;
+mod subpath;
+mod vertex;
+
+pub use connect::{connect, Connection};
+pub use subpath::{generate_camera_subpath, generate_camera_subpath_from, generate_light_subpath};
+pub use vertex::{Mode, Vertex, VertexKind};
+
+use super::MAX_PASS_THROUGH;
+
+/// `bdpt`'s settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BdptSettings {
+    /// Longest path, in bounces (pbrt-v3's `maxdepth`).
+    pub max_depth: u32,
+    /// How the s = 1 strategy chooses a light at the vertex it connects (as `path`); light
+    /// subpaths choose theirs by power, or by this strategy at the camera when it is not the
+    /// BVH (pbrt-v3's `lightsamplestrategy`, looked up at the camera).
+    pub light_strategy: LightStrategy,
+}
+
+/// How lights are chosen: once per sample for the light subpath's origin, and at the
+/// connected vertex for the s = 1 strategy.
+#[derive(Clone, Copy, Debug)]
+pub struct LightChoice {
+    /// The s = 1 strategy's.
+    strategy: LightStrategy,
+    /// The origin's (never the BVH: it bounds a shading point's light).
+    origin: LightStrategy,
+    /// Where the origin's choice is looked up (the camera, as pbrt-v3).
+    at: LightContext,
+}
+
+impl LightChoice {
+    /// The choices of `strategy` for a sample whose camera vertex is at `camera`.
+    pub fn new(strategy: LightStrategy, camera: Vec3) -> Self {
+        Self {
+            strategy,
+            origin: match strategy {
+                LightStrategy::Bvh => LightStrategy::Power,
+                s => s,
+            },
+            at: LightContext {
+                p: camera,
+                n: Vec3::ZERO,
+            },
+        }
+    }
+
+    /// Chooses a light subpath's light with `u`: its index and probability.
+    pub fn sample_origin(&self, scene: &Scene, u: f32) -> Option<(usize, f32)> {
+        scene.choose_light(self.origin, self.at, u)
+    }
+
+    /// The probability that [`LightChoice::sample_origin`] chooses `light`.
+    pub fn origin_pdf(&self, scene: &Scene, light: usize) -> f32 {
+        scene.light_choice_pdf(self.origin, self.at, light)
+    }
+
+    /// Where the s = 1 strategy chooses at `v`.
+    fn context(v: &Vertex) -> LightContext {
+        LightContext { p: v.p, n: v.ns }
+    }
+
+    /// The s = 1 strategy's choice at `v` with `u`: a light and its probability.
+    pub fn sample_at(&self, scene: &Scene, v: &Vertex, u: f32) -> Option<(usize, f32)> {
+        scene.choose_light(self.strategy, Self::context(v), u)
+    }
+
+    /// The density of the s = 1 strategy's choice of the path's light endpoint over the
+    /// origin's choice of it (1 when both choose alike).
+    fn s1_ratio(
+        &self,
+        scene: &Scene,
+        light: &[Vertex],
+        camera: &[Vertex],
+        sampled: Option<&Vertex>,
+        s: usize,
+        t: usize,
+    ) -> f32 {
+        if self.strategy == self.origin && self.strategy != LightStrategy::Spatial {
+            return 1.0;
+        }
+        let ends = match s {
+            0 if t >= 2 => Some((&camera[t - 1], &camera[t - 2])),
+            1 => sampled.map(|v| (v, &camera[t - 1])),
+            _ if light.len() >= 2 => Some((&light[0], &light[1])),
+            _ => None,
+        };
+        let Some((x0, x1)) = ends else { return 1.0 };
+        let at = Self::context(x1);
+        let (num, den) = if x0.is_infinite_light(scene) {
+            let w = (x1.p - x0.p).normalize_or_zero();
+            (
+                vertex::infinite_light_density(scene, w, |i| {
+                    scene.light_choice_pdf(self.strategy, at, i)
+                }),
+                vertex::infinite_light_density(scene, w, |i| self.origin_pdf(scene, i)),
+            )
+        } else {
+            let Some(l) = x0.light else { return 1.0 };
+            (
+                scene.light_choice_pdf(self.strategy, at, l as usize),
+                self.origin_pdf(scene, l as usize),
+            )
+        };
+        let r = num / den;
+        if r.is_finite() {
+            r
+        } else if num > 0.0 {
+            f32::MAX
+        } else {
+            1.0
+        }
+    }
+}
+
+thread_local! {
+    /// The t = 1 strategies' splats of the sample this thread traced last.
+    static SPLATS: RefCell<Vec<(Vec2, Spectrum)>> = const { RefCell::new(Vec::new()) };
+    /// The subpaths' vertices, reused from sample to sample.
+    static PATHS: RefCell<(Vec<Vertex>, Vec<Vertex>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+}
+
+/// The splats (raster position, value) of the sample this thread traced last, taken: the
+/// render loop adds them to the film after each batch, in the batch's order. Empty (and
+/// allocation-free) after any other integrator's sample.
+pub fn take_splats() -> Vec<(Vec2, Spectrum)> {
+    SPLATS.with(|s| {
+        let mut s = s.borrow_mut();
+        if s.is_empty() {
+            Vec::new()
+        } else {
+            std::mem::take(&mut *s)
+        }
+    })
+}
+
+/// One camera sample of bdpt: the radiance of the strategies with t >= 2, the t = 1 ones
+/// left for [`take_splats`].
+pub fn bdpt_li<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    ray: Ray,
+    diff: Option<&RayDifferentials>,
+    sampler: &mut S,
+    settings: BdptSettings,
+) -> Radiance {
+    PATHS.with(|paths| {
+        let (camera, light) = &mut *paths.borrow_mut();
+        let max_depth = settings.max_depth as usize;
+        let n_camera =
+            generate_camera_subpath_from(scene, ray, diff, sampler, max_depth + 2, camera);
+        let choice = LightChoice::new(settings.light_strategy, ray.o);
+        let n_light =
+            generate_light_subpath(scene, sampler, max_depth + 1, ray.time, &choice, light);
+        let mut rays = (n_camera + n_light) as u32;
+        let mut l = Spectrum::ZERO;
+        let mut probe = FirstHitProbe::default();
+        for w in camera.windows(2) {
+            probe.travel(w[0].p, w[1].p);
+            match &w[1].surface {
+                Some(s) => probe.surface(&s.si, &s.bsdf),
+                None => break,
+            }
+        }
+        SPLATS.with(|splats| {
+            let mut splats = splats.borrow_mut();
+            for t in 1..=n_camera {
+                for s in 0..=n_light {
+                    let depth = (t + s) as i64 - 2;
+                    if (s == 1 && t == 1) || depth < 0 || depth > max_depth as i64 {
+                        continue;
+                    }
+                    let c = connect(scene, light, camera, s, t, &choice, sampler);
+                    rays += u32::from(c.traced);
+                    if t != 1 {
+                        l += c.l;
+                    } else if let (Some(r), true) = (c.raster, c.l != Spectrum::ZERO) {
+                        splats.push((r, c.l));
+                    }
+                }
+            }
+        });
+        Radiance {
+            l,
+            rays,
+            first_hit: probe.features(),
+        }
+    })
+}
