@@ -47,12 +47,16 @@ pub struct LightChoice {
     origin: LightStrategy,
     /// Where the origin's choice is looked up (the camera, as pbrt-v3).
     at: LightContext,
+    /// The scene has one light: every choice is that light, with probability 1 (the light
+    /// BVH's importance is not asked; where it would say 0 the light sends nothing there).
+    single: bool,
 }
 
 impl LightChoice {
-    /// The choices of `strategy` for a sample whose camera vertex is at `camera`.
-    pub fn new(strategy: LightStrategy, camera: Vec3) -> Self {
+    /// The choices of `strategy` in `scene` for a sample whose camera vertex is at `camera`.
+    pub fn new(scene: &Scene, strategy: LightStrategy, camera: Vec3) -> Self {
         Self {
+            single: scene.lights.len() == 1,
             strategy,
             origin: match strategy {
                 LightStrategy::Bvh => LightStrategy::Power,
@@ -67,11 +71,17 @@ impl LightChoice {
 
     /// Chooses a light subpath's light with `u`: its index and probability.
     pub fn sample_origin(&self, scene: &Scene, u: f32) -> Option<(usize, f32)> {
+        if self.single {
+            return Some((0, 1.0));
+        }
         scene.choose_light(self.origin, self.at, u)
     }
 
     /// The probability that [`LightChoice::sample_origin`] chooses `light`.
     pub fn origin_pdf(&self, scene: &Scene, light: usize) -> f32 {
+        if self.single {
+            return 1.0;
+        }
         scene.light_choice_pdf(self.origin, self.at, light)
     }
 
@@ -82,6 +92,9 @@ impl LightChoice {
 
     /// The s = 1 strategy's choice at `v` with `u`: a light and its probability.
     pub fn sample_at(&self, scene: &Scene, v: &Vertex, u: f32) -> Option<(usize, f32)> {
+        if self.single {
+            return Some((0, 1.0));
+        }
         scene.choose_light(self.strategy, Self::context(v), u)
     }
 
@@ -96,7 +109,8 @@ impl LightChoice {
         s: usize,
         t: usize,
     ) -> f32 {
-        if self.strategy == self.origin && self.strategy != LightStrategy::Spatial {
+        if self.single || (self.strategy == self.origin && self.strategy != LightStrategy::Spatial)
+        {
             return 1.0;
         }
         let ends = match s {
@@ -168,7 +182,7 @@ pub fn bdpt_li<S: SampleSource + ?Sized>(
         let max_depth = settings.max_depth as usize;
         let n_camera =
             generate_camera_subpath_from(scene, ray, diff, sampler, max_depth + 2, camera);
-        let choice = LightChoice::new(settings.light_strategy, ray.o);
+        let choice = LightChoice::new(scene, settings.light_strategy, ray.o);
         let n_light =
             generate_light_subpath(scene, sampler, max_depth + 1, ray.time, &choice, light);
         let mut rays = (n_camera + n_light) as u32;
