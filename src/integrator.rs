@@ -153,13 +153,13 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
                     "visualizestrategies",
                     ParamType::Bool,
                     "false",
-                    "also write each strategy's unweighted image, bdpt_dDD_sSS_tTT.exr (not yet: a warning)",
+                    "also write each strategy's unweighted image, bdpt_dDD_sSS_tTT.exr beside the output (maxdepth at most 5)",
                 ),
                 ParamSpec::new(
                     "visualizeweights",
                     ParamType::Bool,
                     "false",
-                    "also write each strategy's weighted image (not yet: a warning)",
+                    "also write each strategy's weighted image, as visualizestrategies",
                 ),
             ],
         },
@@ -238,9 +238,24 @@ impl Integrator {
     /// `path`'s).
     pub fn bdpt(c: &Choice) -> Result<Self> {
         let s = path_settings(c)?;
+        let params = &c.params;
+        let weights = params.bool_or("visualizeweights", false)?;
+        let visualize = if weights {
+            Some(bdpt::strategies::Visualize::Weights)
+        } else if params.bool_or("visualizestrategies", false)? {
+            Some(bdpt::strategies::Visualize::Strategies)
+        } else {
+            None
+        };
         Ok(Integrator::Bdpt(BdptSettings {
-            max_depth: s.max_depth,
+            // pbrt-v3 limits the depth to 5 when it writes the strategy images.
+            max_depth: if visualize.is_some() {
+                s.max_depth.min(5)
+            } else {
+                s.max_depth
+            },
             light_strategy: s.light_strategy,
+            visualize,
         }))
     }
 

@@ -234,3 +234,48 @@ fn sample_ranges_merge_their_splats() {
     let from_sums: f32 = wi.iter().map(|p| p[0]).sum();
     assert!((caustic / from_sums - 1.0).abs() < 1e-5);
 }
+
+/// `visualizeweights` writes one image per strategy beside the output (pbrt-v3's names); the
+/// weighted strategies add up to the image (their means: the strategy images are unfiltered).
+#[test]
+fn strategy_images_add_up_to_the_image() {
+    use common::{ok, s, temp_dir};
+    let dir = temp_dir("bdpt-strategies");
+    let scene = root().join("scenes/pbrt-v3/caustic-point.pbrt");
+    let out = dir.join("out.exr");
+    ok(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&out),
+        "-q",
+        "--spp",
+        "16",
+        "--set",
+        "integrator.visualizeweights=true",
+    ]);
+    let image = acr::image_io::read_image(&out, false).unwrap().pixels;
+    let mut total = 0.0;
+    let mut files = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        if name.starts_with("bdpt_d") {
+            files += 1;
+            total += mean_lum(&read_image(&dir.join(&name)));
+        }
+    }
+    assert!(
+        dir.join("bdpt_d03_s04_t01.exr").exists(),
+        "the caustic's strategy"
+    );
+    assert!(files >= 10, "{files} strategy images");
+    let m = total / mean_lum(&image);
+    assert!(
+        (m - 1.0).abs() < 0.005,
+        "strategies sum to {m} of the image"
+    );
+}
+
+fn read_image(path: &std::path::Path) -> Vec<Spectrum> {
+    acr::image_io::read_image(path, false).unwrap().pixels
+}

@@ -17,6 +17,7 @@ use std::cell::RefCell;
 
 mod connect;
 mod mis;
+pub mod strategies;
 mod subpath;
 mod vertex;
 
@@ -35,6 +36,39 @@ pub struct BdptSettings {
     /// subpaths choose theirs by power, or by this strategy at the camera when it is not the
     /// BVH (pbrt-v3's `lightsamplestrategy`, looked up at the camera).
     pub light_strategy: LightStrategy,
+    /// Strategy images to write beside the output (pbrt-v3's `visualizestrategies` and
+    /// `visualizeweights`), if asked.
+    pub visualize: Option<strategies::Visualize>,
+}
+
+/// Before a render with `integrator` of `scene`: starts bdpt's strategy images when asked.
+pub fn begin_render(integrator: &crate::integrator::Integrator, scene: &Scene) {
+    if let crate::integrator::Integrator::Bdpt(BdptSettings {
+        visualize: Some(_), ..
+    }) = integrator
+    {
+        strategies::start(scene.film.resolution);
+    }
+}
+
+/// After it, `samples` traced: writes bdpt's strategy images beside `output`, if asked.
+pub fn end_render(
+    integrator: &crate::integrator::Integrator,
+    scene: &Scene,
+    output: &std::path::Path,
+    samples: u64,
+) -> Result<(), String> {
+    if let crate::integrator::Integrator::Bdpt(BdptSettings {
+        visualize: Some(_), ..
+    }) = integrator
+    {
+        let (w, h) = scene.film.resolution;
+        strategies::finish(
+            output,
+            (u64::from(w) * u64::from(h)) as f64 / samples.max(1) as f64,
+        )?;
+    }
+    Ok(())
 }
 
 /// How lights are chosen: once per sample for the light subpath's origin, and at the
@@ -195,6 +229,7 @@ pub fn bdpt_li<S: SampleSource + ?Sized>(
                 None => break,
             }
         }
+        let mut shown = Vec::new();
         SPLATS.with(|splats| {
             let mut splats = splats.borrow_mut();
             for t in 1..=n_camera {
@@ -205,6 +240,9 @@ pub fn bdpt_li<S: SampleSource + ?Sized>(
                     }
                     let c = connect(scene, light, camera, s, t, &choice, sampler);
                     rays += u32::from(c.traced);
+                    if settings.visualize.is_some() && c.l != Spectrum::ZERO {
+                        shown.push((s, t, c));
+                    }
                     if t != 1 {
                         l += c.l;
                     } else if let (Some(r), true) = (c.raster, c.l != Spectrum::ZERO) {
@@ -213,10 +251,40 @@ pub fn bdpt_li<S: SampleSource + ?Sized>(
                 }
             }
         });
+        if let Some(v) = settings.visualize {
+            show_strategies(scene, &ray, v, &shown);
+        }
         Radiance {
             l,
             rays,
             first_hit: probe.features(),
         }
     })
+}
+
+/// Adds one sample's strategies to the strategy images: t >= 2 at the camera sample's raster
+/// position (found from the camera ray; perspective cameras only), t = 1 where it landed.
+fn show_strategies(
+    scene: &Scene,
+    ray: &Ray,
+    v: strategies::Visualize,
+    shown: &[(usize, usize, Connection)],
+) {
+    let here = scene
+        .camera
+        .we(ray.o, ray.d.normalize(), ray.time)
+        .map(|(_, r)| r);
+    let list: Vec<_> = shown
+        .iter()
+        .filter_map(|&(s, t, c)| {
+            let p = if t == 1 { c.raster } else { here }?;
+            let value = match v {
+                strategies::Visualize::Weights => c.l,
+                strategies::Visualize::Strategies if c.mis_weight > 0.0 => c.l / c.mis_weight,
+                strategies::Visualize::Strategies => Spectrum::ZERO,
+            };
+            Some((s, t, p, value))
+        })
+        .collect();
+    strategies::add(&list);
 }
