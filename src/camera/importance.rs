@@ -126,3 +126,75 @@ impl Camera {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::CameraSample;
+    use std::path::Path;
+
+    fn camera(text: &str, res: (u32, u32)) -> Camera {
+        let d = acr_parser::parse_str(text, Path::new("c.pbrt")).unwrap();
+        Camera::new(d.camera.as_ref().unwrap(), res, glam::DMat4::IDENTITY).unwrap()
+    }
+
+    /// A point seen through a raster position is connected back to that raster position, with
+    /// the densities `Pdf_We` gives the camera ray, for a pinhole and a thin lens.
+    #[test]
+    fn importance_finds_the_raster_position_a_camera_ray_came_from() {
+        for text in [
+            "LookAt 1 2 5 0 0 0 0 1 0 Camera \"perspective\" \"float fov\" 50",
+            "LookAt 1 2 5 0 0 0 0 1 0 Camera \"perspective\" \"float fov\" 50 \
+             \"float lensradius\" 0.2 \"float focaldistance\" 4",
+        ] {
+            let c = camera(text, (80, 60));
+            for (film, lens) in [((40.5, 30.5), (0.3, 0.7)), ((3.2, 57.9), (0.9, 0.1))] {
+                let s = CameraSample {
+                    film: Vec2::new(film.0, film.1),
+                    lens: Vec2::new(lens.0, lens.1),
+                    time: 0.0,
+                };
+                let ray = c.generate_ray(&s);
+                let p = ray.o + ray.d * 4.0;
+                let (we, raster) = c.we(ray.o, ray.d, 0.0).unwrap();
+                assert!((raster - s.film).length() < 1e-2, "{raster} vs {}", s.film);
+                assert!(we.x > 0.0);
+                let (pos, dir) = c.pdf_we(ray.o, ray.d, 0.0);
+                assert!(pos > 0.0 && dir > 0.0);
+                // From the focal point, every lens point lands on the same raster position.
+                let i = c.sample_wi(p, 0.0, Vec2::new(0.5, 0.5)).unwrap();
+                if c.lens_radius == 0.0 {
+                    assert!((i.raster - s.film).length() < 1e-2, "{}", i.raster);
+                }
+                assert!(i.pdf > 0.0 && i.we.x > 0.0);
+            }
+        }
+    }
+
+    /// pbrt-v3's normalisation: the importance of a pinhole, times the cosine, integrates to 1
+    /// over the directions through the film.
+    #[test]
+    fn pinhole_importance_integrates_to_one_over_the_film() {
+        let c = camera("Camera \"perspective\" \"float fov\" 60", (40, 30));
+        let n = 400;
+        let mut sum = 0.0f64;
+        for j in 0..n {
+            for i in 0..n {
+                let film = Vec2::new(
+                    (i as f32 + 0.5) / n as f32 * 40.0,
+                    (j as f32 + 0.5) / n as f32 * 30.0,
+                );
+                let ray = c.generate_ray(&CameraSample {
+                    film,
+                    ..Default::default()
+                });
+                let (we, _) = c.we(ray.o, ray.d, 0.0).unwrap();
+                let (_, pdf_dir) = c.pdf_we(ray.o, ray.d, 0.0);
+                // Uniform over the film: each direction's weight is 1 / (pdf n^2).
+                let cos = ray.d.z.abs();
+                sum += f64::from(we.x * cos / pdf_dir) / (n * n) as f64;
+            }
+        }
+        assert!((sum - 1.0).abs() < 1e-3, "{sum}");
+    }
+}

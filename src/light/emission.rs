@@ -253,3 +253,65 @@ impl Light {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::spot_frame;
+
+    /// `pdf_emission` gives the densities `sample_le` drew its ray with.
+    #[test]
+    fn emission_densities_match_their_samples() {
+        let sphere = WorldSphere {
+            center: Vec3::new(0.5, 0.0, -1.0),
+            radius: 7.0,
+        };
+        let world = Geometry::default();
+        let lights = [
+            Light::Point {
+                pos: Vec3::new(1.0, 2.0, 3.0),
+                intensity: Spectrum::ONE,
+            },
+            Light::Spot {
+                pos: Vec3::ZERO,
+                light_from_world: spot_frame(Vec3::new(0.3, -1.0, 0.2).normalize()),
+                intensity: Spectrum::ONE,
+                cos_total: 0.8,
+                cos_falloff_start: 0.9,
+            },
+            Light::Distant {
+                w: Vec3::new(0.0, 1.0, 0.0),
+                radiance: Spectrum::ONE,
+                world_radius: 7.0,
+            },
+            Light::Infinite {
+                l: Spectrum::ONE,
+                map: None,
+                light_from_world: glam::Mat4::IDENTITY,
+                world_from_light: glam::Mat4::IDENTITY,
+                world_radius: 7.0,
+            },
+        ];
+        for (k, light) in lights.iter().enumerate() {
+            for u in [(0.1, 0.2, 0.3, 0.4), (0.8, 0.6, 0.05, 0.95)] {
+                let s = light
+                    .sample_le(&world, sphere, Vec2::new(u.0, u.1), Vec2::new(u.2, u.3))
+                    .unwrap();
+                let (pos, dir) = light.pdf_emission(sphere, s.n, s.d);
+                assert!(
+                    (pos - s.pdf_pos).abs() <= 1e-4 * pos,
+                    "light {k}: {pos} {}",
+                    s.pdf_pos
+                );
+                if !matches!(light, Light::Distant { .. }) {
+                    assert!(
+                        (dir - s.pdf_dir).abs() <= 1e-3 * dir,
+                        "light {k}: {dir} {}",
+                        s.pdf_dir
+                    );
+                }
+                assert!((s.d.length() - 1.0).abs() < 1e-4);
+            }
+        }
+    }
+}
