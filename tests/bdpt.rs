@@ -279,3 +279,92 @@ fn strategy_images_add_up_to_the_image() {
 fn read_image(path: &std::path::Path) -> Vec<Spectrum> {
     acr::image_io::read_image(path, false).unwrap().pixels
 }
+
+/// The luminance mean of an image file over the caustic reference's, and the caustic window's.
+fn caustic_ratios(path: &std::path::Path) -> (f64, f64) {
+    let img = read_image(path);
+    let reference = read_reference("caustic-point-ref1024.exr");
+    (
+        mean_lum(&img) / mean_lum(&reference),
+        window(&img, 96, CAUSTIC) / window(&reference, 96, CAUSTIC),
+    )
+}
+
+/// The time limit, the noise threshold and SIGTERM stop bdpt cleanly, the splats of the
+/// samples traced at the right scale (the mean within 3% of pbrt-v3's, the caustic, which only
+/// splats make, within 6%: a few dozen spp), with the partial image written under
+/// `--write-partial-images` right as well.
+#[cfg(unix)]
+#[test]
+fn time_limit_noise_threshold_and_sigterm_stop_bdpt_with_its_splats() {
+    use common::{ok, s, temp_dir};
+    let dir = temp_dir("bdpt-stops");
+    let scene = root().join("scenes/pbrt-v3/caustic-point.pbrt");
+    let check = |out: &std::path::Path, what: &str| {
+        let (m, w) = caustic_ratios(out);
+        eprintln!("{what}: mean {m:.4}, caustic {w:.4}");
+        assert!(
+            (m - 1.0).abs() < 0.03 && (w - 1.0).abs() < 0.05,
+            "{what}: {m} {w}"
+        );
+    };
+    for (what, flag, value) in [
+        ("time limit", "--time-limit", "2"),
+        ("noise threshold", "--noise-threshold", "0.2"),
+    ] {
+        let out = dir.join(format!("{}.exr", what.replace(' ', "-")));
+        let stats = dir.join("stats.json");
+        ok(&[
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "-q",
+            "--spp",
+            "100000",
+            flag,
+            value,
+            "--stats",
+            s(&stats),
+        ]);
+        let text = std::fs::read_to_string(&stats).unwrap();
+        let halted = if flag == "--time-limit" {
+            "time"
+        } else {
+            "noise"
+        };
+        assert!(
+            text.contains(&format!("\"halted_by\": \"{halted}\"")),
+            "{text}"
+        );
+        check(&out, what);
+    }
+    let out = dir.join("signal.exr");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_acr"))
+        .args([
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--spp",
+            "100000",
+            "--quiet",
+        ])
+        .args(["--write-partial-images", "0.3"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !out.exists() {
+        assert!(start.elapsed().as_secs() < 120, "no partial image");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    check(&out, "partial image");
+    // SAFETY: kill(2) on our own child's pid, with a valid signal number.
+    let rc = unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    assert_eq!(rc, 0);
+    let output = child.wait_with_output().unwrap();
+    assert!(String::from_utf8_lossy(&output.stderr).contains("interrupted by a signal"));
+    check(&out, "after SIGTERM");
+}
