@@ -234,31 +234,6 @@ impl Integrator {
         Ok(Integrator::VolPath(path_settings(c)?))
     }
 
-    /// `bdpt` from its parameters (pbrt-v3's defaults: maxdepth 5; the light strategy as
-    /// `path`'s).
-    pub fn bdpt(c: &Choice) -> Result<Self> {
-        let s = path_settings(c)?;
-        let params = &c.params;
-        let weights = params.bool_or("visualizeweights", false)?;
-        let visualize = if weights {
-            Some(bdpt::strategies::Visualize::Weights)
-        } else if params.bool_or("visualizestrategies", false)? {
-            Some(bdpt::strategies::Visualize::Strategies)
-        } else {
-            None
-        };
-        Ok(Integrator::Bdpt(BdptSettings {
-            // pbrt-v3 limits the depth to 5 when it writes the strategy images.
-            max_depth: if visualize.is_some() {
-                s.max_depth.min(5)
-            } else {
-                s.max_depth
-            },
-            light_strategy: s.light_strategy,
-            visualize,
-        }))
-    }
-
     /// `directlighting` from its parameters (pbrt-v3's defaults: maxdepth 5, strategy all).
     pub fn direct(c: &Choice) -> Result<Self> {
         let params = &c.params;

@@ -8,11 +8,13 @@
 
 use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, RayDifferentials, Spectrum, Vec2, Vec3};
-use crate::integrator::Radiance;
+use crate::integrator::{Integrator, Radiance};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
 use crate::stream::SampleSource;
+use acr_parser::Result;
+use acr_plugins::Choice;
 use std::cell::RefCell;
 
 mod connect;
@@ -41,9 +43,36 @@ pub struct BdptSettings {
     pub visualize: Option<strategies::Visualize>,
 }
 
+impl Integrator {
+    /// `bdpt` from its parameters (pbrt-v3's defaults: maxdepth 5; the light strategy as
+    /// `path`'s).
+    pub fn bdpt(c: &Choice) -> Result<Self> {
+        let s = super::path_settings(c)?;
+        let params = &c.params;
+        let weights = params.bool_or("visualizeweights", false)?;
+        let visualize = if weights {
+            Some(strategies::Visualize::Weights)
+        } else if params.bool_or("visualizestrategies", false)? {
+            Some(strategies::Visualize::Strategies)
+        } else {
+            None
+        };
+        Ok(Integrator::Bdpt(BdptSettings {
+            // pbrt-v3 limits the depth to 5 when it writes the strategy images.
+            max_depth: if visualize.is_some() {
+                s.max_depth.min(5)
+            } else {
+                s.max_depth
+            },
+            light_strategy: s.light_strategy,
+            visualize,
+        }))
+    }
+}
+
 /// Before a render with `integrator` of `scene`: starts bdpt's strategy images when asked.
-pub fn begin_render(integrator: &crate::integrator::Integrator, scene: &Scene) {
-    if let crate::integrator::Integrator::Bdpt(BdptSettings {
+pub fn begin_render(integrator: &Integrator, scene: &Scene) {
+    if let Integrator::Bdpt(BdptSettings {
         visualize: Some(_), ..
     }) = integrator
     {
@@ -53,12 +82,12 @@ pub fn begin_render(integrator: &crate::integrator::Integrator, scene: &Scene) {
 
 /// After it, `samples` traced: writes bdpt's strategy images beside `output`, if asked.
 pub fn end_render(
-    integrator: &crate::integrator::Integrator,
+    integrator: &Integrator,
     scene: &Scene,
     output: &std::path::Path,
     samples: u64,
 ) -> Result<(), String> {
-    if let crate::integrator::Integrator::Bdpt(BdptSettings {
+    if let Integrator::Bdpt(BdptSettings {
         visualize: Some(_), ..
     }) = integrator
     {
