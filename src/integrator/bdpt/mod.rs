@@ -262,7 +262,10 @@ pub fn bdpt_li<S: SampleSource + ?Sized>(
         SPLATS.with(|splats| {
             let mut splats = splats.borrow_mut();
             for t in 1..=n_camera {
-                for s in 0..=n_light {
+                // s = 1 samples its own light vertex: it runs even when the light subpath made
+                // none (pbrt-v3 skips it then, which loses light where a light's emission
+                // sample can come out black: a projection's or a goniometric map's zeros).
+                for s in 0..=n_light.max(1) {
                     let depth = (t + s) as i64 - 2;
                     if (s == 1 && t == 1) || depth < 0 || depth > max_depth as i64 {
                         continue;

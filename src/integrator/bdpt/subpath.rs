@@ -2,9 +2,7 @@
 //! `RandomWalk`), generic over where their random decisions come from, so that mlt drives
 //! them from its primary sample space.
 
-use super::vertex::{
-    correct_shading_normal, importance_eta, Mode, SurfacePoint, Vertex, VertexKind,
-};
+use super::vertex::{adjoint_f, correct_shading_normal, Mode, SurfacePoint, Vertex, VertexKind};
 use super::{LightChoice, MAX_PASS_THROUGH};
 use crate::camera::CameraSample;
 use crate::geometry::{offset_ray_origin, Ray, RayDifferentials, Spectrum, Vec2, Vec3};
@@ -212,10 +210,10 @@ fn random_walk<S: SampleSource + ?Sized>(
             break;
         }
         pdf_fwd = s.pdf;
-        beta *= s.f * s.wi.dot(si.shading_n).abs() / s.pdf;
+        let f = adjoint_f(bsdf, si, (wo, s.wi), s.f, s.specular, mode);
+        beta *= f * s.wi.dot(si.shading_n).abs() / s.pdf;
         let mut pdf_rev = bsdf.pdf(s.wi, wo);
-        beta *=
-            correct_shading_normal(si, wo, s.wi, mode) * importance_eta(bsdf, si, wo, s.wi, mode);
+        beta *= correct_shading_normal(si, wo, s.wi, mode);
         let next_ray = si.spawn_ray(s.wi);
         if s.specular {
             pdf_rev = 0.0;

@@ -2,7 +2,7 @@
 //! the densities with which each direction of travel generates it, for the MIS weights.
 
 use super::LightChoice;
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, Bxdf};
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec3};
 use crate::light::{Light, WorldSphere};
 use crate::scene::Scene;
@@ -79,20 +79,63 @@ pub fn correct_shading_normal(si: &SurfaceInteraction, wo: Vec3, wi: Vec3, mode:
     }
 }
 
-/// The factor that turns acr's BSDF (radiance transport: transmission scaled by
-/// (eta_i / eta_t)^2) into importance transport's for (wo, wi): pbrt-v3 leaves that scale out
-/// in `TransportMode::Importance`.
-pub fn importance_eta(bsdf: &Bsdf, si: &SurfaceInteraction, wo: Vec3, wi: Vec3, mode: Mode) -> f32 {
-    let (co, ci) = (wo.dot(si.n), wi.dot(si.n));
-    if mode == Mode::Radiance || co * ci >= 0.0 || bsdf.eta() == 1.0 {
-        return 1.0;
-    }
+/// Whether a lobe scales transmitted radiance by (eta_i / eta_t)^2 (the dielectric ones).
+fn scales_radiance(bxdf: &Bxdf) -> bool {
+    matches!(
+        bxdf,
+        Bxdf::SpecularTransmission { .. }
+            | Bxdf::FresnelSpecular { .. }
+            | Bxdf::MicrofacetTransmission { .. }
+    )
+}
+
+/// The factor that undoes radiance's (eta_i / eta_t)^2 across the interface for (wo, wi),
+/// or 1 when they are on one side.
+fn eta_undo(bsdf: &Bsdf, si: &SurfaceInteraction, wo: Vec3) -> f32 {
     let eta = bsdf.eta();
-    // Entering (wo outside): radiance scaled by 1 / eta^2, importance not.
-    if co > 0.0 {
+    // Entering (wo outside): radiance was scaled by 1 / eta^2, importance is not.
+    if wo.dot(si.n) > 0.0 {
         eta * eta
     } else {
         1.0 / (eta * eta)
+    }
+}
+
+/// The BSDF for (wo, wi) in transport `mode`, given its radiance value `f` (the whole BSDF's,
+/// or with `specular` a specular lobe's sample): acr's lobes are radiance's, whose dielectric
+/// transmission is scaled by (eta_i / eta_t)^2; importance transport leaves that out (pbrt-v3's
+/// `TransportMode::Importance`), lobe by lobe, so that a translucent surface's Lambertian
+/// transmission beside its microfacet one keeps its value.
+pub fn adjoint_f(
+    bsdf: &Bsdf,
+    si: &SurfaceInteraction,
+    (wo, wi): (Vec3, Vec3),
+    f: Spectrum,
+    specular: bool,
+    mode: Mode,
+) -> Spectrum {
+    let transmitted = wo.dot(si.n) * wi.dot(si.n) < 0.0;
+    if mode == Mode::Radiance || !transmitted || bsdf.eta() == 1.0 {
+        return f;
+    }
+    let undo = eta_undo(bsdf, si, wo);
+    if specular {
+        // Specular transmission lobes are all dielectric.
+        return f * undo;
+    }
+    let frame = bsdf.frame();
+    let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
+    let dielectric: Spectrum = bsdf
+        .lobes()
+        .iter()
+        .filter(|l| scales_radiance(&l.bxdf))
+        .map(|l| l.scale * l.bxdf.f(lo, li))
+        .sum();
+    let g = f + dielectric * (undo - 1.0);
+    if g.is_finite() {
+        g.max(Spectrum::ZERO)
+    } else {
+        Spectrum::ZERO
     }
 }
 
@@ -204,9 +247,9 @@ impl Vertex {
             return Spectrum::ZERO;
         }
         let wo = s.si.wo;
-        s.bsdf.f(wo, wi)
+        let f = s.bsdf.f(wo, wi);
+        adjoint_f(&s.bsdf, &s.si, (wo, wi), f, false, mode)
             * correct_shading_normal(&s.si, wo, wi, mode)
-            * importance_eta(&s.bsdf, &s.si, wo, wi, mode)
     }
 
     /// A solid-angle density at this vertex towards `next` as an area density there.
