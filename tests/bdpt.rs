@@ -390,3 +390,24 @@ fn bdpt_converges_to_paths_image_through_translucency_and_image_lights() {
     eprintln!("image lights: bdpt mean over path's {m:.4}");
     assert!((m - 1.0).abs() < 0.01, "image lights: {m}");
 }
+
+/// With many lights and the light BVH, the s = 1 strategy chooses at the vertex it connects
+/// and the light subpaths by power: the MIS weights take each strategy's own choice, and the
+/// image is `path`'s (means within 1%); as with `spatial`, looked up at the camera (pbrt-v3).
+#[test]
+fn bdpt_with_many_lights_weighs_each_strategys_light_choice() {
+    let path = root().join("scenes/many-lights.pbrt");
+    let reference = mean_lum(&render_desc(&parse_file(&path).unwrap(), 64, 4).0);
+    for strategy in ["bvh", "spatial"] {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let text = text.replace(
+            "Integrator \"path\"",
+            &format!("Integrator \"bdpt\" \"string lightsamplestrategy\" \"{strategy}\""),
+        );
+        let desc = parse_str(&text, &path).unwrap();
+        assert_eq!(desc.integrator.as_ref().unwrap().kind, "bdpt");
+        let m = mean_lum(&render_desc(&desc, 16, 4).0) / reference;
+        eprintln!("many lights, {strategy}: bdpt mean over path's {m:.4}");
+        assert!((m - 1.0).abs() < 0.01, "{strategy}: {m}");
+    }
+}

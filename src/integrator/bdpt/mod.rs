@@ -34,9 +34,9 @@ use super::MAX_PASS_THROUGH;
 pub struct BdptSettings {
     /// Longest path, in bounces (pbrt-v3's `maxdepth`).
     pub max_depth: u32,
-    /// How the s = 1 strategy chooses a light at the vertex it connects (as `path`); light
-    /// subpaths choose theirs by power, or by this strategy at the camera when it is not the
-    /// BVH (pbrt-v3's `lightsamplestrategy`, looked up at the camera).
+    /// How lights are chosen: with `bvh`, the s = 1 strategy's at the vertex it connects (as
+    /// `path`) and light subpaths' by power; with the others, every choice of a sample by
+    /// this strategy looked up at the camera (pbrt-v3's `lightsamplestrategy`).
     pub light_strategy: LightStrategy,
     /// Strategy images to write beside the output (pbrt-v3's `visualizestrategies` and
     /// `visualizeweights`), if asked.
@@ -100,8 +100,8 @@ pub fn end_render(
     Ok(())
 }
 
-/// How lights are chosen: once per sample for the light subpath's origin, and at the
-/// connected vertex for the s = 1 strategy.
+/// How lights are chosen: once per sample for the light subpath's origin (at the camera, as
+/// pbrt-v3), and, with the light BVH, at the connected vertex for the s = 1 strategy.
 #[derive(Clone, Copy, Debug)]
 pub struct LightChoice {
     /// The s = 1 strategy's.
@@ -158,6 +158,9 @@ impl LightChoice {
         if self.single {
             return Some((0, 1.0));
         }
+        if self.strategy != LightStrategy::Bvh {
+            return self.sample_origin(scene, u);
+        }
         scene.choose_light(self.strategy, Self::context(v), u)
     }
 
@@ -172,8 +175,7 @@ impl LightChoice {
         s: usize,
         t: usize,
     ) -> f32 {
-        if self.single || (self.strategy == self.origin && self.strategy != LightStrategy::Spatial)
-        {
+        if self.single || self.strategy != LightStrategy::Bvh {
             return 1.0;
         }
         let ends = match s {
