@@ -147,7 +147,7 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
                     "lightsamplestrategy",
                     ParamType::String,
                     "bvh",
-                    "how the s = 1 strategy chooses a light (as path: bvh, spatial, power or uniform); light subpaths choose by power (bvh) or by it at the camera",
+                    "bvh: the s = 1 strategy chooses at its vertex (as path), light subpaths by power; spatial, power, uniform: every choice at the camera (pbrt-v3)",
                 ),
                 ParamSpec::new(
                     "visualizestrategies",
