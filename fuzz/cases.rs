@@ -150,6 +150,7 @@ pub fn render(data: &[u8]) {
             s.iterations = s.iterations.min(2);
             s.photons_per_iteration = Some(s.photons_per_iteration.unwrap_or(64).min(64));
         }
+        Integrator::Bdpt(settings) => settings.max_depth = settings.max_depth.min(8),
     }
     let mut film = plugins.film(&scene);
     acr::render::render(

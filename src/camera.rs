@@ -25,6 +25,9 @@ pub struct CameraContext<'a> {
     pub dir: &'a Path,
 }
 
+mod importance;
+pub use importance::ImportanceSample;
+
 /// Where on the film, lens and shutter a camera ray starts.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct CameraSample {

@@ -21,6 +21,7 @@ use acr_parser::{Error, ParamList, ParamType, Result};
 use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 
 mod ao;
+pub mod bdpt;
 mod direct;
 pub mod mlt;
 mod path;
@@ -29,6 +30,7 @@ mod subsurface;
 mod volpath;
 mod whitted;
 pub use ao::AoSettings;
+pub use bdpt::BdptSettings;
 use direct::{direct_li, Tally};
 pub use mlt::MltSettings;
 pub(crate) use path::path_of_depth;
@@ -64,6 +66,8 @@ pub enum Integrator {
     VolPath(VolPathSettings),
     /// `mlt`: primary-sample-space Metropolis light transport (docs/light-transport.md).
     Mlt(MltSettings),
+    /// `bdpt`: bidirectional path tracing (docs/light-transport.md).
+    Bdpt(BdptSettings),
     /// `directlighting`.
     Direct {
         /// Specular recursion depth.
@@ -150,6 +154,40 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
             ],
         },
         build: Integrator::volpath,
+    },
+    Entry {
+        info: PluginInfo {
+            kind: Kind::Integrator,
+            name: "bdpt",
+            doc: "bidirectional path tracing: every connection of a camera and a light subpath, MIS-weighted; light tracing splatted (pbrt-v3 bdpt)",
+            params: &[
+                ParamSpec::new(
+                    "maxdepth",
+                    ParamType::Integer,
+                    "5",
+                    "longest path, in bounces",
+                ),
+                ParamSpec::new(
+                    "lightsamplestrategy",
+                    ParamType::String,
+                    "bvh",
+                    "bvh: the s = 1 strategy chooses at its vertex (as path), light subpaths by power; spatial, power, uniform: every choice at the camera (pbrt-v3)",
+                ),
+                ParamSpec::new(
+                    "visualizestrategies",
+                    ParamType::Bool,
+                    "false",
+                    "also write each strategy's unweighted image, bdpt_dDD_sSS_tTT.exr beside the output (maxdepth at most 5)",
+                ),
+                ParamSpec::new(
+                    "visualizeweights",
+                    ParamType::Bool,
+                    "false",
+                    "also write each strategy's weighted image, as visualizestrategies",
+                ),
+            ],
+        },
+        build: Integrator::bdpt,
     },
     Entry {
         info: PluginInfo {
@@ -317,6 +355,7 @@ impl Integrator {
             Integrator::Path { .. } => "path",
             Integrator::VolPath(_) => "volpath",
             Integrator::Mlt(_) => "mlt",
+            Integrator::Bdpt(_) => "bdpt",
             Integrator::Direct { .. } => "directlighting",
             Integrator::AmbientOcclusion(_) => "ambientocclusion",
             Integrator::Whitted { .. } => "whitted",
@@ -381,6 +420,7 @@ impl Integrator {
                 },
                 LightStrategy::Power,
             ),
+            Integrator::Bdpt(settings) => bdpt::bdpt_li(scene, ray, diff, stream, settings),
             Integrator::Direct {
                 max_depth,
                 strategy,

@@ -118,16 +118,22 @@ fn resolve<'a, B>(
     Ok(entry)
 }
 
-/// pbrt-v3's `bdpt` and `mlt` render participating media: on a scene that has some, their
-/// nearest in acr is `volpath`, not the `path` they map to elsewhere (`volpath` costs about
-/// 1.5x `path`'s CPU time on a scene without media, so the plain alias stays `path`).
+/// pbrt-v3's `bdpt` and `mlt` render participating media (acr's `bdpt` does not yet): on a
+/// scene that has some, their nearest in acr is `volpath`, not what they are elsewhere
+/// (`volpath` costs about 1.5x `path`'s CPU time on a scene without media, so `mlt`'s plain
+/// alias stays `path`).
 fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<Warning>) {
     if desc.media.is_empty() || !matches!(choice.name.as_str(), "bdpt" | "mlt") {
         return;
     }
+    let why = if choice.name == "bdpt" {
+        "renders no participating media yet"
+    } else {
+        "is not implemented"
+    };
     let message = format!(
-        "integrator \"{}\" is not implemented; using \"volpath\", the nearest that renders \
-         the scene's participating media",
+        "integrator \"{}\" {why}; using \"volpath\", the nearest that renders the scene's \
+         participating media",
         choice.name
     );
     warnings.push(match &choice.loc {
@@ -314,8 +320,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrator bdpt -> path (bdpt and mlt -> volpath on \
-         a scene with media).\n",
+         lowdiscrepancy, maxmindist -> sobol; integrators bdpt and mlt -> volpath on a scene \
+         with media.\n",
     );
     out
 }

@@ -160,6 +160,13 @@ struct Traced {
     /// Each point's first-hit features, when the film's cells keep them (values that are not
     /// finite become 0 and are counted); empty otherwise.
     features: Vec<Features>,
+    /// The batch's unfiltered splats (bdpt's light tracing), in the batch's order.
+    splats: Vec<(Vec2, Spectrum)>,
+    /// Samples handed to the film so far: each traced one light subpath, whose splats the
+    /// film scales by full-film pixels over their number (docs/light-transport.md).
+    handed: u64,
+    /// The full film's pixels.
+    full_pixels: u64,
 }
 
 impl Traced {
@@ -176,8 +183,11 @@ impl Traced {
         let split = film.halves().is_some();
         self.radiance.clear();
         self.features.clear();
+        self.splats.clear();
         let keep_features = film.collects_features();
-        for (q, &(l, rays, first_hit)) in self.batch.iter().zip(results) {
+        for (q, (l, rays, first_hit, splats)) in self.batch.iter().zip(results) {
+            let (l, rays, first_hit) = (*l, *rays, *first_hit);
+            self.splats.extend_from_slice(splats);
             counts.rays += u64::from(rays);
             if keep_features {
                 let (f, bad) = sanitized(first_hit.to_array());
@@ -201,8 +211,15 @@ impl Traced {
         counts.samples += self.batch.len() as u64;
     }
 
-    /// Gives the batch to the sampler (its time added to `in_sampler`), then to the film.
-    fn hand_over(&self, sampler: &mut dyn Sampler, film: &mut Film, in_sampler: &mut Duration) {
+    /// Gives the batch to the sampler (its time added to `in_sampler`), then to the film, with
+    /// its splats, scaled for the light subpaths traced so far.
+    fn hand_over(&mut self, sampler: &mut dyn Sampler, film: &mut Film, in_sampler: &mut Duration) {
+        self.handed += self.batch.len() as u64;
+        if !self.splats.is_empty() {
+            film.add_splats(&self.splats);
+        }
+        film.unfiltered_mut()
+            .set_scale(self.full_pixels as f64 / self.handed.max(1) as f64);
         timed(in_sampler, || sampler.observe(&self.batch, &self.radiance));
         let features = film.collects_features().then_some(self.features.as_slice());
         film.add_points(&self.batch, &self.radiance, features);
@@ -229,8 +246,9 @@ fn timed<T>(total: &mut Duration, f: impl FnOnce() -> T) -> T {
 pub type Estimator<'a> =
     dyn Fn(&Scene, Ray, Option<&RayDifferentials>, &mut SampleStream) -> Radiance + Sync + 'a;
 
-/// One traced sample: its radiance, rays and first-hit features.
-type SampleResult = (Spectrum, u32, FirstHit);
+/// One traced sample: its radiance, rays, first-hit features and unfiltered splats (empty,
+/// without allocation, for every integrator but bdpt).
+type SampleResult = (Spectrum, u32, FirstHit, Vec<(Vec2, Spectrum)>);
 
 /// [`render`] with any estimator in place of an integrator (tests give it one that misbehaves).
 /// Radiance that is NaN, infinite or negative is dropped and counted where it arises; the rest
@@ -269,7 +287,11 @@ pub fn render_with(
     let (mut batch, mut next) = (Vec::new(), Vec::new());
     let mut results: Vec<SampleResult> = Vec::new();
     // The last batch traced, when the sampler and the film have not yet seen it.
-    let mut traced = Traced::default();
+    let (w, h) = scene.film.resolution;
+    let mut traced = Traced {
+        full_pixels: u64::from(w) * u64::from(h),
+        ..Traced::default()
+    };
     let mut pending = false;
     let mut in_sampler = Duration::ZERO;
     let last_pixel = space.pixel(space.pixels().saturating_sub(1));
@@ -370,12 +392,18 @@ impl Tracer<'_, '_> {
                 let Some((ray, diff, weight)) =
                     scene.camera.weighted_ray(&sample, scene.uses_differentials)
                 else {
-                    return (Spectrum::ZERO, 0, Default::default());
+                    return (Spectrum::ZERO, 0, Default::default(), Vec::new());
                 };
                 let diff = diff.map(|d| d.scaled(&ray, diff_scale));
                 let r = li(scene, ray, diff.as_ref(), &mut stream);
                 // Every camera but the realistic one weighs 1: x * 1 is x, images unchanged.
-                (r.l * weight, r.rays, r.first_hit)
+                // bdpt's light-tracing splats are not the camera sample's: not weighted.
+                (
+                    r.l * weight,
+                    r.rays,
+                    r.first_hit,
+                    crate::integrator::bdpt::take_splats(),
+                )
             })
             .collect_into_vec(results);
     }

@@ -102,7 +102,6 @@ const ALIASES: &[(Kind, &str, &str)] = &[
     (Kind::Sampler, "02sequence", "sobol"),
     (Kind::Sampler, "lowdiscrepancy", "sobol"),
     (Kind::Sampler, "maxmindist", "sobol"),
-    (Kind::Integrator, "bdpt", "path"),
 ];
 
 /// Finds the plugin called `name` among `entries` (of kind `kind`). A pbrt-v3 name acr lacks

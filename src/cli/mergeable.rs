@@ -44,6 +44,12 @@ pub struct Sums {
     pub footprint: Option<u32>,
     /// Render seconds, summed over merged renders.
     pub seconds: f64,
+    /// Per pixel: the unfiltered splats' sums (bdpt's light tracing; `splat.R`, `splat.G`,
+    /// `splat.B`, times the film's scale), when any landed in the crop.
+    pub splats: Option<Vec<[f64; 3]>>,
+    /// The light subpaths traced per full-film pixel (`splatSpp`), by which the image divides
+    /// the splat sums (docs/light-transport.md), when the render said.
+    pub splat_spp: Option<f64>,
 }
 
 /// The channels [`Sums`] reads and writes itself; any other is an AOV.
@@ -65,20 +71,32 @@ const OWN_CHANNELS: &[&str] = &[
     "Variance.R",
     "Variance.G",
     "Variance.B",
+    "splat.R",
+    "splat.G",
+    "splat.B",
 ];
 
 impl Sums {
     /// The image: each pixel's weighted mean (0 where no weight, and never negative, as the
-    /// film makes it).
+    /// film makes it), plus its splat sum over the light subpaths per full-film pixel.
     pub fn image(&self) -> Vec<[f32; 3]> {
+        let splat_scale = match self.splat_spp {
+            Some(n) if n > 0.0 => 1.0 / n,
+            _ => 0.0,
+        };
         self.sums
             .iter()
-            .map(|s| {
+            .enumerate()
+            .map(|(i, s)| {
+                let splat = self
+                    .splats
+                    .as_ref()
+                    .map_or([0.0; 3], |p| p[i].map(|v| v * splat_scale));
                 if s[3] == 0.0 {
-                    return [0.0; 3];
+                    return splat.map(|v| v as f32);
                 }
                 let inv = 1.0 / s[3];
-                [0, 1, 2].map(|c| ((s[c] * inv) as f32).max(0.0))
+                [0, 1, 2].map(|c| ((s[c] * inv) as f32).max(0.0) + splat[c] as f32)
             })
             .collect()
     }
@@ -158,12 +176,42 @@ impl Sums {
             }
             _ => None,
         };
+        self.add_splats(other)?;
         self.offset = match (self.range(), other.range()) {
             (Some(a), Some(b)) => Some(a.start.min(b.start) as u32),
             _ => None,
         };
         self.spp += other.spp;
         self.seconds += other.seconds;
+        Ok(())
+    }
+
+    /// Adds `other`'s splat sums and light subpaths; a file without splat channels adds none
+    /// but its subpaths still count.
+    fn add_splats(&mut self, other: &Sums) -> std::result::Result<(), String> {
+        let any = self.splats.is_some() || other.splats.is_some();
+        self.splat_spp = match (self.splat_spp, other.splat_spp) {
+            (Some(a), Some(b)) => Some(a + b),
+            (None, None) => None,
+            _ if any => {
+                return Err(
+                    "one file lacks splatSpp, the light subpaths behind its splats".to_owned(),
+                )
+            }
+            _ => None,
+        };
+        self.splats = match (self.splats.take(), &other.splats) {
+            (Some(mut a), Some(b)) => {
+                for (x, y) in a.iter_mut().zip(b) {
+                    for c in 0..3 {
+                        x[c] += y[c];
+                    }
+                }
+                Some(a)
+            }
+            (Some(a), None) => Some(a),
+            (None, b) => b.clone(),
+        };
         Ok(())
     }
 
@@ -191,8 +239,18 @@ impl Sums {
                 layer.push(&format!("Variance.{rgb}"), pick(&|i| var[i][c]));
             }
         }
+        if let Some(splats) = &self.splats {
+            for (c, name) in ["splat.R", "splat.G", "splat.B"].into_iter().enumerate() {
+                layer.push(name, pick(&|i| splats[i][c] as f32));
+            }
+        }
         for (name, values) in &self.aovs {
             layer.push(name, values.clone());
+        }
+        if let Some(n) = self.splat_spp {
+            layer
+                .attributes
+                .push(("splatSpp".into(), Attribute::Float(n as f32)));
         }
         let spp = self.spp.min(i32::MAX as u32) as i32;
         layer
@@ -261,6 +319,14 @@ impl Sums {
             Some(Attribute::Float(v)) => f64::from(v),
             _ => 0.0,
         };
+        let splats = match (find("splat.R"), find("splat.G"), find("splat.B")) {
+            (Some(r), Some(g), Some(b)) => Some((0..r.len()).map(|i| [r[i], g[i], b[i]]).collect()),
+            _ => None,
+        };
+        let splat_spp = match layer.attribute("splatSpp") {
+            Some(Attribute::Float(v)) => Some(f64::from(v)),
+            _ => None,
+        };
         let aovs = layer
             .channels
             .iter()
@@ -283,6 +349,8 @@ impl Sums {
                 _ => None,
             },
             seconds,
+            splats,
+            splat_spp,
         })
     }
 }

@@ -104,6 +104,17 @@ impl Output {
             scene: Some(self.scene),
             footprint: self.footprint,
             seconds,
+            splats: (!film.unfiltered().sums().is_empty()).then(|| {
+                film.unfiltered()
+                    .sums()
+                    .iter()
+                    .map(|s| s.map(|v| v * scale))
+                    .collect()
+            }),
+            // The film scales its splats by full-film pixels over light subpaths traced; written
+            // with the splats only, so that other integrators' files stay as they were.
+            splat_spp: (!film.unfiltered().sums().is_empty() && film.unfiltered().scale() > 0.0)
+                .then(|| 1.0 / film.unfiltered().scale()),
         })
     }
 

@@ -1,179 +1,53 @@
-//! Rays leaving the lights: pbrt-v3's `Light::Sample_Le`, the first vertex of a photon path
-//! (sppm) or a light subpath. docs/light-transport.md.
+//! Light emission as a light subpath starts it: pbrt-v3's `Light::Sample_Le` (a ray leaving
+//! the light, with the densities of its origin and of its direction) and `Light::Pdf_Le`, for
+//! bdpt's light subpaths and their MIS weights (docs/light-transport.md).
 
-use super::{area_emission, sample_area, EnvMap, Light};
-use crate::geometry::{Frame, Ray, Spectrum, Vec2, Vec3};
+use super::{area_emission, goniometric_scale, sample_area, Light};
+use crate::accel::Geometry;
+use crate::geometry::{offset_ray_origin, Frame, Ray, Spectrum, Vec2, Vec3};
 use crate::sampling::{
     concentric_sample_disk, cosine_sample_hemisphere, uniform_cone_pdf, uniform_sample_cone,
     uniform_sample_sphere,
 };
 use crate::scene::Scene;
-use std::f32::consts::PI;
+use std::f32::consts::{FRAC_1_PI, PI};
 
-/// A ray sampled leaving a light, with what it carries and its densities.
+/// A ray leaving a light (pbrt-v3's `Sample_Le` result).
 #[derive(Clone, Copy, Debug)]
-pub struct LeSample {
-    /// The ray (unit direction).
-    pub ray: Ray,
-    /// The normal at its origin (the ray's direction for point and infinite-like lights).
+pub struct EmissionSample {
+    /// Where the ray starts.
+    pub o: Vec3,
+    /// Its unit direction.
+    pub d: Vec3,
+    /// The light's surface normal there (zero for lights not on a surface).
     pub n: Vec3,
     /// Emitted radiance (intensity for point lights) along the ray.
     pub le: Spectrum,
     /// Density of the origin (area measure; 1 for point lights).
     pub pdf_pos: f32,
-    /// Density of the direction (solid angle; 1 for a distant light).
+    /// Density of the direction (solid angle).
     pub pdf_dir: f32,
 }
 
-/// pbrt-v3's `Light::Sample_Le`: a ray leaving `light` (one of `scene.lights`) chosen with
-/// `u1` (position, or direction for point lights) and `u2`, at `time`; `None` when it carries
-/// nothing or has zero density.
-pub fn sample_le(scene: &Scene, light: &Light, u1: Vec2, u2: Vec2, time: f32) -> Option<LeSample> {
-    let s = match light {
-        Light::Point { pos, intensity } => {
-            let d = uniform_sample_sphere(u1);
-            point_sample(*pos, d, *intensity, 1.0 / (4.0 * PI), time)
-        }
-        Light::Spot {
-            pos,
-            light_from_world,
-            intensity,
-            cos_total,
-            cos_falloff_start,
-        } => {
-            let wl = uniform_sample_cone(u1, *cos_total);
-            // A rotation: its transpose takes light space back to world space.
-            let d = light_from_world
-                .transpose()
-                .transform_vector3(wl)
-                .normalize();
-            let falloff = spot_falloff(wl.z, *cos_total, *cos_falloff_start);
-            point_sample(
-                *pos,
-                d,
-                *intensity * falloff,
-                uniform_cone_pdf(*cos_total),
-                time,
-            )
-        }
-        Light::Goniometric {
-            pos,
-            light_from_world,
-            intensity,
-            map,
-        } => {
-            let wl = uniform_sample_sphere(u1);
-            let d = light_from_world.inverse().transform_vector3(wl).normalize();
-            let scale = super::goniometric_scale(map.as_ref(), wl);
-            point_sample(*pos, d, *intensity * scale, 1.0 / (4.0 * PI), time)
-        }
-        Light::Projection {
-            pos,
-            light_from_world,
-            intensity,
-            projection,
-        } => {
-            let cos_total = projection.cos_total_width;
-            let wl = uniform_sample_cone(u1, cos_total);
-            let d = light_from_world.inverse().transform_vector3(wl).normalize();
-            let le = *intensity * projection.eval(wl);
-            point_sample(*pos, d, le, uniform_cone_pdf(cos_total), time)
-        }
-        Light::Distant {
-            w,
-            radiance,
-            world_radius,
-        } => {
-            let o = disk_point(scene.world_center, *world_radius, *w, u1);
-            LeSample {
-                ray: Ray::new(o, -*w, time),
-                n: -*w,
-                le: *radiance,
-                pdf_pos: 1.0 / (PI * world_radius * world_radius),
-                pdf_dir: 1.0,
-            }
-        }
-        Light::Area {
-            shape,
-            l_emit,
-            two_sided,
-            area,
-        } => {
-            let (p, n) = sample_area(&scene.accel.world, shape.kind, u1);
-            if n == Vec3::ZERO || *area <= 0.0 {
-                return None;
-            }
-            let (wl, pdf_dir) = if *two_sided {
-                // The first coordinate picks the side, then is stretched back to [0, 1).
-                let below = 1.0 - f32::EPSILON / 2.0;
-                let (ux, flip) = if u2.x < 0.5 {
-                    ((u2.x * 2.0).min(below), false)
-                } else {
-                    (((u2.x - 0.5) * 2.0).min(below), true)
-                };
-                let mut w = cosine_sample_hemisphere(Vec2::new(ux, u2.y));
-                if flip {
-                    w.z = -w.z;
-                }
-                (w, 0.5 * w.z.abs() / PI)
-            } else {
-                let w = cosine_sample_hemisphere(u2);
-                (w, w.z / PI)
-            };
-            let d = Frame::from_z(n).from_local(wl);
-            // Off the surface, to the side the ray leaves by, by a margin relative to the
-            // point's magnitude (the sampled point carries no error bound).
-            let side = if d.dot(n) >= 0.0 { n } else { -n };
-            let o = p + side * (1e-4 * (1.0 + p.abs().max_element()));
-            LeSample {
-                ray: Ray::new(o, d, time),
-                n,
-                le: area_emission(*l_emit, *two_sided, n, d),
-                pdf_pos: 1.0 / area,
-                pdf_dir,
-            }
-        }
-        Light::Infinite {
-            l,
-            map,
-            world_from_light,
-            world_radius,
-            ..
-        } => {
-            let (wi, pdf_dir, le) = infinite_direction(map.as_ref(), world_from_light, u1)?;
-            // Light arrives from `wi`: the ray travels along -wi from a disk facing it.
-            let o = disk_point(scene.world_center, *world_radius, wi, u2);
-            LeSample {
-                ray: Ray::new(o, -wi, time),
-                n: -wi,
-                le: *l * le,
-                pdf_pos: 1.0 / (PI * world_radius * world_radius),
-                pdf_dir,
-            }
-        }
-    };
-    let usable = s.pdf_pos > 0.0
-        && s.pdf_dir > 0.0
-        && s.pdf_pos.is_finite()
-        && s.pdf_dir.is_finite()
-        && s.le != Spectrum::ZERO
-        && s.ray.d.is_finite();
-    usable.then_some(s)
+/// The world's bounding sphere, where distant and infinite lights start their rays.
+#[derive(Clone, Copy, Debug)]
+pub struct WorldSphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
 }
 
-/// A ray from point light position `pos` along unit `d`.
-fn point_sample(pos: Vec3, d: Vec3, le: Spectrum, pdf_dir: f32, time: f32) -> LeSample {
-    LeSample {
-        ray: Ray::new(pos, d, time),
-        n: d,
-        le,
-        pdf_pos: 1.0,
-        pdf_dir,
-    }
+/// A point on the disk of radius `r` facing `d` through `center`, from `u`.
+fn disk_point(center: Vec3, r: f32, d: Vec3, u: Vec2) -> Vec3 {
+    let f = Frame::from_z(d);
+    let cd = concentric_sample_disk(u);
+    center + r * (cd.x * f.s + cd.y * f.t)
 }
 
-/// pbrt-v3's spot falloff at light-space cosine `cos_theta` (as `Light::sample_li`).
-fn spot_falloff(cos_theta: f32, cos_total: f32, cos_falloff_start: f32) -> f32 {
+/// The spot light's falloff for the light-space direction `wl` (unit).
+fn spot_falloff(wl: Vec3, cos_total: f32, cos_falloff_start: f32) -> f32 {
+    let cos_theta = wl.z;
     if cos_theta < cos_total {
         0.0
     } else if cos_theta >= cos_falloff_start {
@@ -184,36 +58,302 @@ fn spot_falloff(cos_theta: f32, cos_total: f32, cos_falloff_start: f32) -> f32 {
     }
 }
 
-/// A point on the disk of radius `radius` facing unit `w`, centred `radius` from `center`
-/// towards `w` (where rays arriving from direction `w` start).
-fn disk_point(center: Vec3, radius: f32, w: Vec3, u: Vec2) -> Vec3 {
-    let f = Frame::from_z(w);
-    let cd = concentric_sample_disk(u);
-    center + radius * (cd.x * f.s + cd.y * f.t) + radius * w
+impl Light {
+    /// pbrt-v3's `Sample_Le`: a ray leaving the light from `u1` (origin) and `u2`
+    /// (direction); `None` when the light sends nothing or the densities are zero. Point,
+    /// goniometric and projection lights sample the sphere uniformly (pbrt-v3 samples the
+    /// projection's cone: the same expectation), spot lights their cone.
+    pub fn sample_le(
+        &self,
+        world: &Geometry,
+        sphere: WorldSphere,
+        u1: Vec2,
+        u2: Vec2,
+    ) -> Option<EmissionSample> {
+        let point = |pos: Vec3, d: Vec3, le: Spectrum, pdf_dir: f32| EmissionSample {
+            o: pos,
+            d,
+            n: Vec3::ZERO,
+            le,
+            pdf_pos: 1.0,
+            pdf_dir,
+        };
+        let sphere_pdf = 1.0 / (4.0 * PI);
+        let s = match self {
+            Light::Point { pos, intensity } => {
+                point(*pos, uniform_sample_sphere(u1), *intensity, sphere_pdf)
+            }
+            Light::Spot {
+                pos,
+                light_from_world,
+                intensity,
+                cos_total,
+                cos_falloff_start,
+            } => {
+                let wl = uniform_sample_cone(u1, *cos_total);
+                // The spot's frame is a rotation: its transpose turns light space to world.
+                let d = light_from_world
+                    .transpose()
+                    .transform_vector3(wl)
+                    .normalize();
+                let le = *intensity * spot_falloff(wl, *cos_total, *cos_falloff_start);
+                point(*pos, d, le, uniform_cone_pdf(*cos_total))
+            }
+            Light::Goniometric {
+                pos,
+                light_from_world,
+                intensity,
+                map,
+            } => {
+                let d = uniform_sample_sphere(u1);
+                let wl = light_from_world.transform_vector3(d);
+                let le = *intensity * goniometric_scale(map.as_ref(), wl);
+                point(*pos, d, le, sphere_pdf)
+            }
+            Light::Projection {
+                pos,
+                light_from_world,
+                intensity,
+                projection,
+            } => {
+                let d = uniform_sample_sphere(u1);
+                let wl = light_from_world.transform_vector3(d);
+                point(*pos, d, *intensity * projection.eval(wl), sphere_pdf)
+            }
+            Light::Distant { w, radiance, .. } => {
+                let d = -*w;
+                let p = disk_point(sphere.center, sphere.radius, d, u1);
+                EmissionSample {
+                    o: p - d * sphere.radius,
+                    d,
+                    n: Vec3::ZERO,
+                    le: *radiance,
+                    pdf_pos: 1.0 / (PI * sphere.radius * sphere.radius),
+                    pdf_dir: 1.0,
+                }
+            }
+            Light::Area {
+                shape,
+                l_emit,
+                two_sided,
+                area,
+            } => {
+                let (p, n) = sample_area(world, shape.kind, u1);
+                if n == Vec3::ZERO {
+                    return None;
+                }
+                let (mut u, flip) = (u2, *two_sided && u2.x >= 0.5);
+                if *two_sided {
+                    let x = if flip { (u.x - 0.5) * 2.0 } else { u.x * 2.0 };
+                    u.x = x.min(1.0 - f32::EPSILON);
+                }
+                let mut wl = cosine_sample_hemisphere(u);
+                if flip {
+                    wl.z = -wl.z;
+                }
+                let pdf_dir = wl.z.abs() * FRAC_1_PI * if *two_sided { 0.5 } else { 1.0 };
+                let f = Frame::from_z(n);
+                let d = (wl.x * f.s + wl.y * f.t + wl.z * f.n).normalize();
+                EmissionSample {
+                    o: p,
+                    d,
+                    n,
+                    le: area_emission(*l_emit, *two_sided, n, d),
+                    pdf_pos: 1.0 / area,
+                    pdf_dir,
+                }
+            }
+            Light::Infinite { l, map, .. } => {
+                // The direction towards the light as `sample_li` picks it; the ray comes in.
+                let ls = self.sample_li(world, sphere.center, u1)?;
+                let d = -ls.wi;
+                let p = disk_point(sphere.center, sphere.radius, d, u2);
+                let le = match map {
+                    Some(_) => ls.li,
+                    None => *l,
+                };
+                EmissionSample {
+                    o: p - d * sphere.radius,
+                    d,
+                    n: Vec3::ZERO,
+                    le,
+                    pdf_pos: 1.0 / (PI * sphere.radius * sphere.radius),
+                    pdf_dir: ls.pdf,
+                }
+            }
+        };
+        let ok = s.pdf_pos > 0.0 && s.pdf_dir > 0.0 && s.le != Spectrum::ZERO;
+        (ok && s.pdf_pos.is_finite() && s.pdf_dir.is_finite()).then_some(s)
+    }
+
+    /// pbrt-v3's `Pdf_Le`: the densities (origin, direction) with which [`Light::sample_le`]
+    /// starts a ray at `p` (normal `n` on an area light) along unit `d`.
+    pub fn pdf_emission(&self, sphere: WorldSphere, n: Vec3, d: Vec3) -> (f32, f32) {
+        let sphere_pdf = 1.0 / (4.0 * PI);
+        let disk_pdf = 1.0 / (PI * sphere.radius * sphere.radius);
+        match self {
+            Light::Point { .. } | Light::Goniometric { .. } | Light::Projection { .. } => {
+                (1.0, sphere_pdf)
+            }
+            Light::Spot {
+                light_from_world,
+                cos_total,
+                ..
+            } => {
+                let wl = light_from_world.transform_vector3(d);
+                let inside = wl.z >= *cos_total;
+                (
+                    1.0,
+                    if inside {
+                        uniform_cone_pdf(*cos_total)
+                    } else {
+                        0.0
+                    },
+                )
+            }
+            Light::Distant { .. } => (disk_pdf, 0.0),
+            Light::Area {
+                two_sided, area, ..
+            } => {
+                let c = n.dot(d);
+                let pdf_dir = if *two_sided {
+                    0.5 * c.abs() * FRAC_1_PI
+                } else {
+                    c.max(0.0) * FRAC_1_PI
+                };
+                (1.0 / area, pdf_dir)
+            }
+            Light::Infinite { .. } => (disk_pdf, self.pdf_le(-d)),
+        }
+    }
 }
 
-/// The direction light arrives from (world), its solid-angle density and the map's value
-/// there (1 without a map), as `Light::sample_li` picks it for an infinite light.
-fn infinite_direction(
-    map: Option<&EnvMap>,
-    world_from_light: &glam::Mat4,
-    u: Vec2,
-) -> Option<(Vec3, f32, Spectrum)> {
-    match map {
-        Some(m) => {
-            let (st, map_pdf) = m.distribution.sample(u);
-            if map_pdf == 0.0 {
-                return None;
+impl Light {
+    /// [`Light::sample_li`] with the light's surface normal at the point chosen (zero for
+    /// lights not on a surface), as bdpt's light vertices need it. Area lights pick their
+    /// point uniformly by area (spheres too: the normal must be the chosen point's).
+    pub fn sample_li_with_normal(
+        &self,
+        world: &Geometry,
+        p: Vec3,
+        u: Vec2,
+    ) -> Option<(super::LightSample, Vec3)> {
+        match self {
+            Light::Area {
+                shape,
+                l_emit,
+                two_sided,
+                area,
+            } => {
+                let (q, n) = sample_area(world, shape.kind, u);
+                let pdf = super::area_to_solid_angle(p, q, n, *area)?;
+                let ls = super::area_light_sample(p, q, n, pdf, *l_emit, *two_sided)?;
+                Some((ls, n))
             }
-            let (theta, phi) = (st.y * PI, st.x * 2.0 * PI);
-            let sin_theta = theta.sin();
-            if sin_theta == 0.0 {
-                return None;
-            }
-            let wl = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), theta.cos());
-            let wi = world_from_light.transform_vector3(wl).normalize();
-            Some((wi, map_pdf / (2.0 * PI * PI * sin_theta), m.lookup(st)))
+            _ => self.sample_li(world, p, u).map(|ls| (ls, Vec3::ZERO)),
         }
-        None => Some((uniform_sample_sphere(u), 1.0 / (4.0 * PI), Spectrum::ONE)),
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::spot_frame;
+
+    /// `pdf_emission` gives the densities `sample_le` drew its ray with.
+    #[test]
+    fn emission_densities_match_their_samples() {
+        let sphere = WorldSphere {
+            center: Vec3::new(0.5, 0.0, -1.0),
+            radius: 7.0,
+        };
+        let world = Geometry::default();
+        let lights = [
+            Light::Point {
+                pos: Vec3::new(1.0, 2.0, 3.0),
+                intensity: Spectrum::ONE,
+            },
+            Light::Spot {
+                pos: Vec3::ZERO,
+                light_from_world: spot_frame(Vec3::new(0.3, -1.0, 0.2).normalize()),
+                intensity: Spectrum::ONE,
+                cos_total: 0.8,
+                cos_falloff_start: 0.9,
+            },
+            Light::Distant {
+                w: Vec3::new(0.0, 1.0, 0.0),
+                radiance: Spectrum::ONE,
+                world_radius: 7.0,
+            },
+            Light::Infinite {
+                l: Spectrum::ONE,
+                map: None,
+                light_from_world: glam::Mat4::IDENTITY,
+                world_from_light: glam::Mat4::IDENTITY,
+                world_radius: 7.0,
+            },
+        ];
+        for (k, light) in lights.iter().enumerate() {
+            for u in [(0.1, 0.2, 0.3, 0.4), (0.8, 0.6, 0.05, 0.95)] {
+                let s = light
+                    .sample_le(&world, sphere, Vec2::new(u.0, u.1), Vec2::new(u.2, u.3))
+                    .unwrap();
+                let (pos, dir) = light.pdf_emission(sphere, s.n, s.d);
+                assert!(
+                    (pos - s.pdf_pos).abs() <= 1e-4 * pos,
+                    "light {k}: {pos} {}",
+                    s.pdf_pos
+                );
+                if !matches!(light, Light::Distant { .. }) {
+                    assert!(
+                        (dir - s.pdf_dir).abs() <= 1e-3 * dir,
+                        "light {k}: {dir} {}",
+                        s.pdf_dir
+                    );
+                }
+                assert!((s.d.length() - 1.0).abs() < 1e-4);
+            }
+        }
+    }
+}
+
+/// A ray sampled leaving a light, ready to trace (sppm's photons).
+#[derive(Clone, Copy, Debug)]
+pub struct LeSample {
+    /// The ray (unit direction), off the light's surface.
+    pub ray: Ray,
+    /// The normal at its origin (the ray's direction for lights not on a surface).
+    pub n: Vec3,
+    /// Emitted radiance (intensity for point lights) along the ray.
+    pub le: Spectrum,
+    /// Density of the origin (area measure; 1 for point lights).
+    pub pdf_pos: f32,
+    /// Density of the direction (solid angle).
+    pub pdf_dir: f32,
+}
+
+/// [`Light::sample_le`] for `light` (one of `scene.lights`) as a ray at `time`: from the
+/// scene's world sphere, the origin moved off an area light's surface to the side the ray
+/// leaves by, and a light not on a surface given the ray's direction as its normal (as bdpt's
+/// light subpaths take it).
+pub fn sample_le(scene: &Scene, light: &Light, u1: Vec2, u2: Vec2, time: f32) -> Option<LeSample> {
+    let sphere = WorldSphere {
+        center: scene.world_center,
+        radius: scene.world_radius,
+    };
+    let e = light.sample_le(&scene.accel.world, sphere, u1, u2)?;
+    let on_area = e.n != Vec3::ZERO;
+    let (n, o) = if on_area {
+        let side = if e.n.dot(e.d) < 0.0 { -e.n } else { e.n };
+        (e.n, offset_ray_origin(e.o, side))
+    } else {
+        (e.d, e.o)
+    };
+    Some(LeSample {
+        ray: Ray::new(o, e.d, time),
+        n,
+        le: e.le,
+        pdf_pos: e.pdf_pos,
+        pdf_dir: e.pdf_dir,
+    })
 }

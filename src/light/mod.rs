@@ -15,6 +15,7 @@ use std::f32::consts::PI;
 
 pub mod emission;
 pub mod light_image;
+pub use emission::{EmissionSample, WorldSphere};
 
 /// A light sample as seen from a point.
 #[derive(Clone, Copy, Debug)]

@@ -89,6 +89,7 @@ pub(super) fn render_scene(
         let [x0, x1, y0, y1] = job.scene.film.crop;
         FeatureImage::new(x0, x1, y0, y1)
     });
+    crate::integrator::bdpt::begin_render(&job.plugins.integrator, &job.scene);
     let counts = render_with_features(
         &job.scene,
         &job.plugins.integrator,
@@ -100,6 +101,12 @@ pub(super) fn render_scene(
         features.as_mut(),
     );
     warn_of_non_finite_features(features.as_ref(), &counts);
+    crate::integrator::bdpt::end_render(
+        &job.plugins.integrator,
+        &job.scene,
+        &target.out.path,
+        counts.samples,
+    )?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

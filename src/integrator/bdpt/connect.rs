@@ -1,0 +1,170 @@
+//! Connecting a light subpath's first s vertices to a camera subpath's first t (pbrt-v3's
+//! `ConnectBDPT`, `G` and `MISWeight`).
+
+use super::vertex::{Mode, Vertex, VertexKind};
+use super::LightChoice;
+use crate::geometry::{Spectrum, Vec2};
+use crate::scene::Scene;
+use crate::stream::SampleSource;
+
+/// One strategy's contribution.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Connection {
+    /// The path's contribution, MIS-weighted.
+    pub l: Spectrum,
+    /// Where it lands on the film when the strategy found the camera itself (t = 1).
+    pub raster: Option<Vec2>,
+    /// Its MIS weight.
+    pub mis_weight: f32,
+    /// Whether a shadow ray was traced.
+    pub traced: bool,
+}
+
+/// Whether the segment between `a` and `b` is free (one of them at least is a surface, or
+/// one lies at infinity).
+fn unoccluded(scene: &Scene, a: &Vertex, b: &Vertex) -> bool {
+    let (from, to) = if a.surface.is_some() { (a, b) } else { (b, a) };
+    match &from.surface {
+        Some(s) => !scene.occluded(&s.si, to.p),
+        None => {
+            let d = to.p - from.p;
+            let ray = crate::geometry::Ray::new(from.p, d, from.time);
+            !scene
+                .accel
+                .occluded(&ray, 1.0 - crate::geometry::SHADOW_EPSILON)
+        }
+    }
+}
+
+/// pbrt-v3's `G` without visibility: the geometry term between two vertices.
+fn geometry_term(a: &Vertex, b: &Vertex) -> f32 {
+    let d = a.p - b.p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return 0.0;
+    }
+    let mut g = 1.0 / d2;
+    let d = d * g.sqrt();
+    if a.on_surface() {
+        g *= a.ns.dot(d).abs();
+    }
+    if b.on_surface() {
+        g *= b.ns.dot(d).abs();
+    }
+    g
+}
+
+/// pbrt-v3's `ConnectBDPT` for strategy (s, t): `light` and `camera` hold at least s and t
+/// vertices.
+pub fn connect<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    light: &[Vertex],
+    camera: &[Vertex],
+    s: usize,
+    t: usize,
+    choice: &LightChoice,
+    sampler: &mut S,
+) -> Connection {
+    let mut c = Connection::default();
+    // A camera path that escaped connects to nothing.
+    if t > 1 && s != 0 && camera[t - 1].kind == VertexKind::Light {
+        return c;
+    }
+    let mut sampled = None;
+    let mut l = Spectrum::ZERO;
+    if s == 0 {
+        let pt = &camera[t - 1];
+        if pt.is_light() {
+            l = pt.le(scene, &camera[t - 2]) * pt.beta;
+        }
+    } else if t == 1 {
+        let qs = &light[s - 1];
+        let u = sampler.next_2d();
+        if qs.connectible(scene) {
+            if let Some(i) = scene.camera.sample_wi(qs.p, qs.time, u) {
+                if i.pdf > 0.0 && i.we != Spectrum::ZERO {
+                    let v = Vertex::camera(i.p, i.n, qs.time, i.we / i.pdf);
+                    l = qs.beta * qs.f(&v, Mode::Importance) * v.beta;
+                    if qs.on_surface() {
+                        l *= i.wi.dot(qs.ns).abs();
+                    }
+                    if l != Spectrum::ZERO {
+                        c.traced = true;
+                        if !unoccluded(scene, qs, &v) {
+                            l = Spectrum::ZERO;
+                        }
+                    }
+                    c.raster = Some(i.raster);
+                    sampled = Some(v);
+                }
+            }
+        }
+    } else if s == 1 {
+        let pt = &camera[t - 1];
+        let u_light = sampler.next_1d();
+        let u = sampler.next_2d();
+        if pt.connectible(scene) {
+            if let Some((v, weight)) = sample_light_vertex(scene, pt, choice, u_light, u) {
+                l = pt.beta * pt.f(&v, Mode::Radiance) * weight;
+                if pt.on_surface() {
+                    l *= (v.p - pt.p).normalize_or_zero().dot(pt.ns).abs();
+                }
+                if l != Spectrum::ZERO {
+                    c.traced = true;
+                    if !unoccluded(scene, pt, &v) {
+                        l = Spectrum::ZERO;
+                    }
+                }
+                sampled = Some(v);
+            }
+        }
+    } else {
+        let (qs, pt) = (&light[s - 1], &camera[t - 1]);
+        if qs.connectible(scene) && pt.connectible(scene) {
+            l = qs.beta * qs.f(pt, Mode::Importance) * pt.f(qs, Mode::Radiance) * pt.beta;
+            if l != Spectrum::ZERO {
+                l *= geometry_term(qs, pt);
+                c.traced = true;
+                if l != Spectrum::ZERO && !unoccluded(scene, qs, pt) {
+                    l = Spectrum::ZERO;
+                }
+            }
+        }
+    }
+    if l == Spectrum::ZERO {
+        return c;
+    }
+    let w = super::mis::mis_weight(scene, light, camera, sampled.as_ref(), s, t, choice);
+    c.mis_weight = w;
+    c.l = l * w;
+    c
+}
+
+/// The s = 1 strategy's light vertex seen from `pt`: a light chosen at `pt` as `path` chooses
+/// one (the strategy's choice), a point on it by `Light::sample_li`, and the weight
+/// Le / (pdf of the point and of the choice); `None` when it sends nothing.
+fn sample_light_vertex(
+    scene: &Scene,
+    pt: &Vertex,
+    choice: &LightChoice,
+    u_light: f32,
+    u: Vec2,
+) -> Option<(Vertex, Spectrum)> {
+    let (index, choice_pdf) = choice.sample_at(scene, pt, u_light)?;
+    let light = &scene.lights[index];
+    let (ls, n) = light.sample_li_with_normal(&scene.accel.world, pt.p, u)?;
+    if ls.pdf <= 0.0 || ls.li == Spectrum::ZERO {
+        return None;
+    }
+    let weight = ls.li / (ls.pdf * choice_pdf);
+    let mut v = Vertex::endpoint(
+        VertexKind::Light,
+        ls.p,
+        n,
+        pt.time,
+        weight,
+        Some(index as u32),
+    );
+    v.pdf_fwd = v.pdf_light_origin(scene, pt, choice);
+    Some((v, weight))
+}

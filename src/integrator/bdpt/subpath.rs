@@ -1,0 +1,232 @@
+//! Camera and light subpaths (pbrt-v3's `GenerateCameraSubpath`, `GenerateLightSubpath` and
+//! `RandomWalk`), generic over where their random decisions come from, so that mlt drives
+//! them from its primary sample space.
+
+use super::vertex::{adjoint_f, correct_shading_normal, Mode, SurfacePoint, Vertex, VertexKind};
+use super::{LightChoice, MAX_PASS_THROUGH};
+use crate::camera::CameraSample;
+use crate::geometry::{offset_ray_origin, Ray, RayDifferentials, Spectrum, Vec2, Vec3};
+use crate::light::WorldSphere;
+use crate::scene::Scene;
+use crate::stream::SampleSource;
+
+/// pbrt-v3's `GenerateCameraSubpath` for a film position drawn from `sampler`: the film
+/// point (uniform over the full film), then time and lens, then the walk. Returns the
+/// vertices made and the raster position.
+pub fn generate_camera_subpath<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    sampler: &mut S,
+    max_depth: usize,
+    path: &mut Vec<Vertex>,
+) -> (usize, Vec2) {
+    let (w, h) = scene.film.resolution;
+    let u = sampler.next_2d();
+    let film = Vec2::new(u.x * w as f32, u.y * h as f32);
+    let time = sampler.next_1d();
+    let lens = sampler.next_2d();
+    let ray = scene
+        .camera
+        .generate_ray(&CameraSample { film, lens, time });
+    let n = generate_camera_subpath_from(scene, ray, None, sampler, max_depth, path);
+    (n, film)
+}
+
+/// The camera subpath that starts with the camera ray `ray` (and its differentials, which
+/// the first hit takes): the vertices made, at most `max_depth`.
+pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    ray: Ray,
+    diff: Option<&RayDifferentials>,
+    sampler: &mut S,
+    max_depth: usize,
+    path: &mut Vec<Vertex>,
+) -> usize {
+    path.clear();
+    if max_depth == 0 {
+        return 0;
+    }
+    path.push(Vertex::camera(ray.o, Vec3::ZERO, ray.time, Spectrum::ONE));
+    let pdf_dir = scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
+    let walk = Walk {
+        beta: Spectrum::ONE,
+        pdf: pdf_dir,
+        max_depth: max_depth - 1,
+        mode: Mode::Radiance,
+    };
+    random_walk(scene, ray, diff, sampler, walk, path) + 1
+}
+
+/// pbrt-v3's `GenerateLightSubpath`: a light chosen by `choice`, a ray leaving it, then the
+/// walk; the vertices made, at most `max_depth`.
+pub fn generate_light_subpath<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    sampler: &mut S,
+    max_depth: usize,
+    time: f32,
+    choice: &LightChoice,
+    path: &mut Vec<Vertex>,
+) -> usize {
+    path.clear();
+    if max_depth == 0 {
+        return 0;
+    }
+    let picked = choice.sample_origin(scene, sampler.next_1d());
+    let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
+    let Some((index, light_pdf)) = picked else {
+        return 0;
+    };
+    let light = &scene.lights[index];
+    let sphere = WorldSphere {
+        center: scene.world_center,
+        radius: scene.world_radius,
+    };
+    let Some(e) = light.sample_le(&scene.accel.world, sphere, u1, u2) else {
+        return 0;
+    };
+    // pbrt-v3 gives lights not on a surface the ray's direction as their normal.
+    let on_area = e.n != Vec3::ZERO;
+    let n = if on_area { e.n } else { e.d };
+    let mut start = Vertex::endpoint(VertexKind::Light, e.o, n, time, e.le, Some(index as u32));
+    start.pdf_fwd = e.pdf_pos * light_pdf;
+    path.push(start);
+    let beta = e.le * n.dot(e.d).abs() / (light_pdf * e.pdf_pos * e.pdf_dir);
+    let o = if on_area {
+        offset_ray_origin(e.o, if n.dot(e.d) < 0.0 { -n } else { n })
+    } else {
+        e.o
+    };
+    let walk = Walk {
+        beta,
+        pdf: e.pdf_dir,
+        max_depth: max_depth - 1,
+        mode: Mode::Importance,
+    };
+    let n_walk = random_walk(scene, Ray::new(o, e.d, time), None, sampler, walk, path);
+    // Infinite lights: the first surface's density is the disk's, and the light's that of
+    // the direction (pbrt-v3's correction).
+    if path[0].is_infinite_light(scene) {
+        if n_walk > 0 {
+            let v = &mut path[1];
+            v.pdf_fwd = e.pdf_pos;
+            if v.on_surface() {
+                v.pdf_fwd *= e.d.dot(v.ng).abs();
+            }
+        }
+        path[0].pdf_fwd =
+            super::vertex::infinite_light_density(scene, e.d, |i| choice.origin_pdf(scene, i));
+    }
+    n_walk + 1
+}
+
+/// How a random walk starts.
+struct Walk {
+    /// The throughput so far.
+    beta: Spectrum,
+    /// The solid-angle density of the first ray's direction.
+    pdf: f32,
+    /// Most vertices to add.
+    max_depth: usize,
+    /// Radiance (camera) or importance (light).
+    mode: Mode,
+}
+
+/// pbrt-v3's `RandomWalk` (without media, and without Russian roulette, as pbrt-v3's bdpt):
+/// adds up to `walk.max_depth` vertices to `path` (which holds the start) and returns how
+/// many.
+fn random_walk<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    mut ray: Ray,
+    mut diff: Option<&RayDifferentials>,
+    sampler: &mut S,
+    walk: Walk,
+    path: &mut Vec<Vertex>,
+) -> usize {
+    if walk.max_depth == 0 {
+        return 0;
+    }
+    let Walk {
+        mut beta,
+        pdf,
+        max_depth,
+        mode,
+    } = walk;
+    let mut pdf_fwd = pdf;
+    let mut bounces = 0;
+    let mut pass_through = 0;
+    loop {
+        let Some(hit) = scene.intersect(&ray) else {
+            // Camera rays that escape end on the infinite lights.
+            if mode == Mode::Radiance {
+                let d = ray.d.normalize();
+                let mut v =
+                    Vertex::endpoint(VertexKind::Light, ray.o + d, -d, ray.time, beta, None);
+                v.pdf_fwd = pdf_fwd;
+                path.push(v);
+                bounces += 1;
+            }
+            break;
+        };
+        let mut si = hit.si;
+        if let Some(d) = diff.take() {
+            si.compute_differentials(d);
+        }
+        let Some(material) = hit.surface.material else {
+            pass_through += 1;
+            if pass_through > MAX_PASS_THROUGH {
+                break;
+            }
+            ray = si.spawn_ray(ray.d);
+            continue;
+        };
+        let material = &scene.materials[material as usize];
+        let si = material.shading(&si);
+        let bsdf = material.bsdf(&si);
+        let prev = path.len() - 1;
+        let point = SurfacePoint { si, bsdf };
+        let vertex = Vertex::surface(
+            point,
+            hit.surface.area_light,
+            beta,
+            pdf_fwd,
+            &path[prev],
+            scene,
+        );
+        path.push(vertex);
+        bounces += 1;
+        if bounces >= max_depth {
+            break;
+        }
+        let u_lobe = sampler.next_1d();
+        let u = sampler.next_2d();
+        let here = path.last().and_then(|v| v.surface.as_ref());
+        let Some(SurfacePoint { si, bsdf }) = here else {
+            break;
+        };
+        let wo = si.wo;
+        let Some(s) = bsdf.sample_f(wo, u, u_lobe) else {
+            break;
+        };
+        if s.f == Spectrum::ZERO || s.pdf <= 0.0 {
+            break;
+        }
+        pdf_fwd = s.pdf;
+        let f = adjoint_f(bsdf, si, (wo, s.wi), s.f, s.specular, mode);
+        beta *= f * s.wi.dot(si.shading_n).abs() / s.pdf;
+        let mut pdf_rev = bsdf.pdf(s.wi, wo);
+        beta *= correct_shading_normal(si, wo, s.wi, mode);
+        let next_ray = si.spawn_ray(s.wi);
+        if s.specular {
+            pdf_rev = 0.0;
+            pdf_fwd = 0.0;
+        }
+        if !crate::geometry::is_valid_radiance(beta) {
+            break;
+        }
+        let n = path.len();
+        path[n - 1].delta = s.specular;
+        let rev = path[n - 1].convert_density(pdf_rev, &path[n - 2], scene);
+        path[n - 2].pdf_rev = rev;
+        ray = next_ray;
+    }
+    bounces
+}
