@@ -33,7 +33,6 @@ pub use ao::AoSettings;
 pub use bdpt::BdptSettings;
 use direct::{direct_li, Tally};
 pub use mlt::MltSettings;
-pub(crate) use path::path_of_depth;
 use path::{path_li, PathRange};
 pub use volpath::VolPathSettings;
 

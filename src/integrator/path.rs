@@ -129,8 +129,7 @@ pub(super) struct PathRange {
 
 /// The path integrator's estimate of the radiance along `ray`: at each scattering a light
 /// sample and a BSDF sample, emission found weighted by MIS, Russian roulette after depth 3.
-/// Only contributions of lengths in `range` are added (`path` counts from 0; mlt asks for
-/// one length at a time, see [`path_of_depth`]).
+/// Only contributions of lengths in `range` are added.
 pub(super) fn path_li(
     scene: &Scene,
     mut ray: Ray,
@@ -285,24 +284,4 @@ pub(super) fn path_li(
         rays,
         first_hit: probe.features(),
     }
-}
-
-/// The part of `path`'s estimate along the camera ray `ray` made by paths of exactly `depth`
-/// scattering vertices, without Russian roulette: summed over depths 0 to `max_depth` it is
-/// `path`'s estimate with that `maxdepth` (without roulette). What mlt's interim path
-/// contribution traces (docs/light-transport.md, `## mlt`).
-pub(crate) fn path_of_depth(
-    scene: &Scene,
-    ray: Ray,
-    diff: Option<&RayDifferentials>,
-    stream: &mut impl SampleSource,
-    depth: u32,
-    light_strategy: LightStrategy,
-) -> Radiance {
-    let range = PathRange {
-        min_depth: depth,
-        max_depth: depth,
-        rr_threshold: 0.0,
-    };
-    path_li(scene, ray, diff, stream, range, light_strategy)
 }
