@@ -382,7 +382,6 @@ impl Integrator {
                 diff,
                 stream,
                 PathRange {
-                    min_depth: 0,
                     max_depth,
                     rr_threshold,
                 },
@@ -396,7 +395,6 @@ impl Integrator {
                 diff,
                 stream,
                 PathRange {
-                    min_depth: 0,
                     max_depth: m.max_depth,
                     rr_threshold: 1.0,
                 },
@@ -413,7 +411,6 @@ impl Integrator {
                 diff,
                 stream,
                 PathRange {
-                    min_depth: 0,
                     max_depth: s.max_depth,
                     rr_threshold: 1.0,
                 },
