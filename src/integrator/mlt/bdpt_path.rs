@@ -112,3 +112,34 @@ impl PathContribution for BdptContribution {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Depth 0 has the one strategy s = 0, t = 2; depth d chooses each of its d + 2 (s, t)
+    /// with s + t = d + 2, about uniformly.
+    #[test]
+    fn strategies_cover_each_depth_uniformly() {
+        for _ in 0..4 {
+            let mut sampler = MltSampler::new(1, 0, 0.01, 0.3);
+            sampler.start_stream(CAMERA_STREAM);
+            assert_eq!(BdptContribution::strategy(&mut sampler, 0), (0, 2, 1));
+        }
+        for depth in 1..6u32 {
+            let n = depth as usize + 2;
+            let mut counts = vec![0u32; n];
+            for i in 0..4000 {
+                let mut sampler = MltSampler::new(7, i, 0.01, 0.3);
+                sampler.start_stream(CAMERA_STREAM);
+                let (s, t, k) = BdptContribution::strategy(&mut sampler, depth);
+                assert_eq!((s + t, k), (n, n));
+                counts[s] += 1;
+            }
+            let expected = 4000.0 / n as f64;
+            for c in counts {
+                assert!((f64::from(c) / expected - 1.0).abs() < 0.2, "{depth}: {c}");
+            }
+        }
+    }
+}
