@@ -33,7 +33,6 @@ pub use ao::AoSettings;
 pub use bdpt::BdptSettings;
 use direct::{direct_li, Tally};
 pub use mlt::MltSettings;
-pub(crate) use path::path_of_depth;
 use path::{path_li, PathRange};
 pub use volpath::VolPathSettings;
 
@@ -383,7 +382,6 @@ impl Integrator {
                 diff,
                 stream,
                 PathRange {
-                    min_depth: 0,
                     max_depth,
                     rr_threshold,
                 },
@@ -397,7 +395,6 @@ impl Integrator {
                 diff,
                 stream,
                 PathRange {
-                    min_depth: 0,
                     max_depth: m.max_depth,
                     rr_threshold: 1.0,
                 },
@@ -414,7 +411,6 @@ impl Integrator {
                 diff,
                 stream,
                 PathRange {
-                    min_depth: 0,
                     max_depth: s.max_depth,
                     rr_threshold: 1.0,
                 },

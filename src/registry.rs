@@ -118,21 +118,14 @@ fn resolve<'a, B>(
     Ok(entry)
 }
 
-/// pbrt-v3's `bdpt` and `mlt` render participating media (acr's `bdpt` does not yet): on a
-/// scene that has some, their nearest in acr is `volpath`, not what they are elsewhere
-/// (`volpath` costs about 1.5x `path`'s CPU time on a scene without media, so `mlt`'s plain
-/// alias stays `path`).
+/// pbrt-v3's `bdpt` and `mlt` render participating media (acr's `bdpt`, and so `mlt`, whose
+/// paths are bdpt's, do not yet): on a scene that has some, their nearest in acr is `volpath`.
 fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<Warning>) {
     if desc.media.is_empty() || !matches!(choice.name.as_str(), "bdpt" | "mlt") {
         return;
     }
-    let why = if choice.name == "bdpt" {
-        "renders no participating media yet"
-    } else {
-        "is not implemented"
-    };
     let message = format!(
-        "integrator \"{}\" {why}; using \"volpath\", the nearest that renders the scene's \
+        "integrator \"{}\" renders no participating media yet; using \"volpath\", the nearest that renders the scene's \
          participating media",
         choice.name
     );

@@ -115,12 +115,10 @@ pub(super) fn next_event(
     }
 }
 
-/// Which path lengths `path_li` counts, in scattering vertices (0: emission the camera ray
+/// The longest path `path_li` traces, in scattering vertices (0: emission the camera ray
 /// finds; a light sample at the first hit makes a path of length 1), and how it ends.
 #[derive(Clone, Copy)]
 pub(super) struct PathRange {
-    /// Contributions of shorter paths are traced past but not added.
-    pub(super) min_depth: u32,
     /// Longest path, in bounces.
     pub(super) max_depth: u32,
     /// Russian roulette below this throughput (0: never).
@@ -129,8 +127,6 @@ pub(super) struct PathRange {
 
 /// The path integrator's estimate of the radiance along `ray`: at each scattering a light
 /// sample and a BSDF sample, emission found weighted by MIS, Russian roulette after depth 3.
-/// Only contributions of lengths in `range` are added (`path` counts from 0; mlt asks for
-/// one length at a time, see [`path_of_depth`]).
 pub(super) fn path_li(
     scene: &Scene,
     mut ray: Ray,
@@ -140,7 +136,6 @@ pub(super) fn path_li(
     light_strategy: LightStrategy,
 ) -> Radiance {
     let PathRange {
-        min_depth,
         max_depth,
         rr_threshold,
     } = range;
@@ -161,9 +156,6 @@ pub(super) fn path_li(
     loop {
         rays += 1;
         let Some(hit) = scene.intersect(&ray) else {
-            if depth < min_depth {
-                break;
-            }
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
@@ -180,7 +172,7 @@ pub(super) fn path_li(
             si.compute_differentials(d);
         }
         probe.travel(ray.o, si.p);
-        if let Some(li) = hit.surface.area_light.filter(|_| depth >= min_depth) {
+        if let Some(li) = hit.surface.area_light {
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
             if le != Spectrum::ZERO {
@@ -213,13 +205,9 @@ pub(super) fn path_li(
                 n: si.shading_n,
             };
             last.ctx = Some(ctx);
-            // A light sample here makes a path one longer than this one; a shorter one than
-            // asked for is not traced.
-            if depth + 1 >= min_depth {
-                let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
-                if let Some(direct) = direct {
-                    l += beta * direct;
-                }
+            let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
+            if let Some(direct) = direct {
+                l += beta * direct;
             }
         }
         let u_lobe = stream.next_1d();
@@ -263,9 +251,7 @@ pub(super) fn path_li(
                 &mut last,
                 &mut rays,
             );
-            if depth + 1 >= min_depth {
-                l += at_exit;
-            }
+            l += at_exit;
             let Some(next) = exit else { break };
             ray = next;
         }
@@ -285,24 +271,4 @@ pub(super) fn path_li(
         rays,
         first_hit: probe.features(),
     }
-}
-
-/// The part of `path`'s estimate along the camera ray `ray` made by paths of exactly `depth`
-/// scattering vertices, without Russian roulette: summed over depths 0 to `max_depth` it is
-/// `path`'s estimate with that `maxdepth` (without roulette). What mlt's interim path
-/// contribution traces (docs/light-transport.md, `## mlt`).
-pub(crate) fn path_of_depth(
-    scene: &Scene,
-    ray: Ray,
-    diff: Option<&RayDifferentials>,
-    stream: &mut impl SampleSource,
-    depth: u32,
-    light_strategy: LightStrategy,
-) -> Radiance {
-    let range = PathRange {
-        min_depth: depth,
-        max_depth: depth,
-        rr_threshold: 0.0,
-    };
-    path_li(scene, ray, diff, stream, range, light_strategy)
 }

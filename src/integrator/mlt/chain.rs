@@ -3,7 +3,8 @@
 //! (the image is the same for a seed), and so that a time limit or a signal stops them between
 //! rounds (docs/light-transport.md, `## mlt`).
 
-use super::contribution::{Contribution, PathContribution, PathTraced};
+use super::bdpt_path::BdptContribution;
+use super::contribution::{Contribution, PathContribution};
 use super::sampler::MltSampler;
 use super::MltSettings;
 use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
@@ -213,7 +214,7 @@ pub fn render(
     stop: &Stop,
     progress: Option<&indicatif::ProgressBar>,
 ) -> RenderCounts {
-    let f = PathTraced {
+    let f = BdptContribution {
         max_depth: settings.max_depth,
         light_strategy: LightStrategy::Bvh,
         differential_scale: 1.0 / (settings.mutations_per_pixel.max(1) as f32).sqrt(),

@@ -1,14 +1,10 @@
 //! What mlt's chains sample: a path function of primary sample space, one path length at a
-//! time ([`PathContribution`]), and the function acr uses until bdpt's is plugged in
-//! ([`PathTraced`]): path tracing restricted to one length (docs/light-transport.md, `## mlt`).
+//! time ([`PathContribution`]; bdpt's is `super::bdpt_path::BdptContribution`), see
+//! docs/light-transport.md, `## mlt`.
 
-use super::sampler::{MltSampler, CAMERA_STREAM};
-use crate::camera::CameraSample;
+use super::sampler::MltSampler;
 use crate::geometry::{Spectrum, Vec2};
-use crate::integrator::path_of_depth;
-use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
-use crate::stream::SampleSource;
 use acr_plugins::RenderingSpace;
 
 /// One evaluation of the path function: the radiance it carries to the film and where.
@@ -28,7 +24,7 @@ pub struct Contribution {
 /// raster area sampled): mlt's bootstrap estimates that total, and the chains its share per
 /// pixel.
 ///
-/// pbrt-v3's `L`, the shape the bdpt adapter takes:
+/// pbrt-v3's `L`, as `super::bdpt_path::BdptContribution` implements it:
 ///
 /// 1. `start_stream(CAMERA_STREAM)`; for `depth` 0 the one strategy `s = 0, t = 2`
 ///    (`n_strategies = 1`), else `n_strategies = depth + 2`,
@@ -52,58 +48,6 @@ pub trait PathContribution: Sync {
         sampler: &mut MltSampler,
         depth: u32,
     ) -> Contribution;
-}
-
-/// The path function until bdpt's lands: a unidirectional path of exactly `depth` bounces
-/// from a camera ray, `path`'s estimator (light samples and BSDF samples combined by MIS)
-/// restricted to that length and without Russian roulette, all its decisions drawn from the
-/// camera stream. PSSMLT over a path tracer, as Kelemen et al.'s.
-#[derive(Clone, Copy, Debug)]
-pub struct PathTraced {
-    /// The longest path, in bounces.
-    pub max_depth: u32,
-    /// How a light is chosen for a light sample.
-    pub light_strategy: LightStrategy,
-    /// The camera ray's differentials' scale: 1/sqrt(mutations per pixel), as pbrt-v3's bdpt
-    /// scales them by its sampler's samples per pixel (the MLT sampler's are its mutations).
-    pub differential_scale: f32,
-}
-
-impl PathContribution for PathTraced {
-    fn max_depth(&self) -> u32 {
-        self.max_depth
-    }
-
-    fn l(
-        &self,
-        scene: &Scene,
-        space: &RenderingSpace,
-        sampler: &mut MltSampler,
-        depth: u32,
-    ) -> Contribution {
-        sampler.start_stream(CAMERA_STREAM);
-        let raster = raster_position(space, sampler.next_2d());
-        let time = sampler.next_1d();
-        let lens = sampler.next_2d();
-        let sample = CameraSample {
-            film: raster,
-            lens,
-            time,
-        };
-        let r = if scene.uses_differentials {
-            let (ray, diff) = scene.camera.generate_ray_differential(&sample);
-            let diff = diff.scaled(&ray, self.differential_scale);
-            path_of_depth(scene, ray, Some(&diff), sampler, depth, self.light_strategy)
-        } else {
-            let ray = scene.camera.generate_ray(&sample);
-            path_of_depth(scene, ray, None, sampler, depth, self.light_strategy)
-        };
-        Contribution {
-            l: r.l,
-            raster,
-            rays: r.rays,
-        }
-    }
 }
 
 /// The raster position of `u` in [0, 1)^2 over `space`'s pixels, kept inside them (rounding

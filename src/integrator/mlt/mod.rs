@@ -5,9 +5,11 @@
 //! splats the proposed and the current state, weighted by the acceptance, onto the film's
 //! unfiltered splats, scaled in the end by `b / mutationsperpixel`.
 //!
-//! The path function the chains sample is [`contribution::PathContribution`]; until bdpt's
-//! lands it is [`contribution::PathTraced`], path tracing restricted to one path length.
+//! The path function the chains sample is [`contribution::PathContribution`]: bdpt's paths,
+//! one connection strategy at a time ([`bdpt_path::BdptContribution`], pbrt-v3's
+//! `MLTIntegrator::L`).
 
+pub mod bdpt_path;
 pub mod chain;
 pub mod contribution;
 pub mod sampler;
@@ -40,7 +42,7 @@ pub const ENTRY: Entry<IntegratorBuild> = Entry {
     info: PluginInfo {
         kind: Kind::Integrator,
         name: "mlt",
-        doc: "Metropolis light transport in primary sample space (pbrt-v3 mlt; over a path tracer until bdpt lands)",
+        doc: "Metropolis light transport in primary sample space (pbrt-v3 mlt, over bdpt's paths)",
         params: &[
             ParamSpec::new(
                 "maxdepth",
