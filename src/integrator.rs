@@ -1,7 +1,8 @@
 //! Integrators: the enum every render dispatches on, their registry entries and parameters.
 //! `path` (`src/integrator/path.rs`: unidirectional path tracing with light and BSDF sampling
 //! combined by multiple importance sampling, and Russian roulette as pbrt-v3),
-//! `directlighting` (`src/integrator/direct.rs`), `volpath` (docs/media.md), and pbrt-v3's
+//! `directlighting` (`src/integrator/direct.rs`; the light sampling both share in
+//! `src/integrator/light_sample.rs`), `volpath` (docs/media.md), and pbrt-v3's
 //! other integrators (docs/light-transport.md), one file or folder each.
 //!
 //! The path integrator follows pbrt-v3's PathIntegrator in what it estimates, with one change
@@ -23,6 +24,7 @@ use acr_plugins::{Choice, Entry, Kind, ParamSpec, PluginInfo};
 mod ao;
 pub mod bdpt;
 mod direct;
+mod light_sample;
 pub mod mlt;
 mod path;
 pub mod sppm;

@@ -1,7 +1,7 @@
 //! `directlighting`: pbrt-v3's DirectLightingIntegrator, and the specular differentials
 //! `whitted` shares.
 
-use super::path::sample_light;
+use super::light_sample::sample_light;
 use super::{DirectStrategy, MAX_PASS_THROUGH};
 use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};

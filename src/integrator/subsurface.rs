@@ -5,7 +5,7 @@
 //! sampled at the exit point through the adapter BSDF, and the path continues from there by a
 //! sample of that BSDF. Kept apart from `path` so that `volpath` can call it too.
 
-use super::path::{next_event, LastScatter};
+use super::light_sample::{next_event, LastScatter};
 use super::MAX_PASS_THROUGH;
 use crate::accel::Hit;
 use crate::bssrdf::{adapter_bsdf, TabulatedBssrdf};
