@@ -118,19 +118,15 @@ fn resolve<'a, B>(
     Ok(entry)
 }
 
-/// pbrt-v3's `bdpt` and `mlt` render participating media (acr's `bdpt` does not yet): on a
-/// scene that has some, their nearest in acr is `volpath`, not what they are elsewhere
-/// (`volpath` costs about 1.5x `path`'s CPU time on a scene without media, so `mlt`'s plain
-/// alias stays `path`).
+/// pbrt-v3's `mlt` renders participating media, acr's does not yet: on a scene that has
+/// some, its nearest in acr is `volpath`, not what it is elsewhere (`volpath` costs about 1.5x
+/// `path`'s CPU time on a scene without media, so `mlt`'s plain alias stays `path`). `bdpt`
+/// renders media itself (docs/light-transport.md).
 fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<Warning>) {
-    if desc.media.is_empty() || !matches!(choice.name.as_str(), "bdpt" | "mlt") {
+    if desc.media.is_empty() || choice.name != "mlt" {
         return;
     }
-    let why = if choice.name == "bdpt" {
-        "renders no participating media yet"
-    } else {
-        "is not implemented"
-    };
+    let why = "renders no participating media yet";
     let message = format!(
         "integrator \"{}\" {why}; using \"volpath\", the nearest that renders the scene's \
          participating media",
@@ -145,7 +141,7 @@ fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<
 
 /// pbrt-v3's warning for a scene with media rendered by an integrator that ignores them.
 fn media_warning(desc: &SceneDescription, integrator: &Integrator, warnings: &mut Vec<Warning>) {
-    if desc.media.is_empty() || matches!(integrator, Integrator::VolPath(_)) {
+    if desc.media.is_empty() || matches!(integrator, Integrator::VolPath(_) | Integrator::Bdpt(_)) {
         return;
     }
     let message = format!(
@@ -320,8 +316,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt and mlt -> volpath on a scene \
-         with media.\n",
+         lowdiscrepancy, maxmindist -> sobol; integrator mlt -> volpath on a scene with \
+         media.\n",
     );
     out
 }

@@ -39,6 +39,8 @@ impl Builder<'_> {
                     area,
                 });
                 self.light_samples.push(samples);
+                let media = self.surfaces[surface as usize].media;
+                self.light_media.push(media.unwrap_or_default());
                 self.surfaces[surface as usize].area_light = Some((self.lights.len() - 1) as u32);
             }
         }
@@ -58,6 +60,11 @@ impl Builder<'_> {
             };
             self.lights.push(light);
             self.light_samples.push(samples);
+            let outside = l.media.outside.map(|m| m as u32);
+            self.light_media.push(crate::medium::MediumInterface {
+                inside: outside,
+                outside,
+            });
         }
         Ok(())
     }
