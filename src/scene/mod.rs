@@ -59,9 +59,9 @@ pub struct Scene {
     pub media: Vec<crate::medium::Medium>,
     /// The medium the camera sits in (`None`: vacuum).
     pub camera_medium: Option<u32>,
-    /// The media around each light, by light index: a `LightSource`'s is the interface's
-    /// outside medium on both sides (pbrt-v3's), an area light's its surface's when that
-    /// separates two media, else vacuum (what bdpt's light subpaths start in).
+    /// The media around each light, by light index (what bdpt's light subpaths start in): a
+    /// `LightSource`'s is the interface's outside medium on both sides, an area light's its
+    /// shape's `MediumInterface` (pbrt-v3's).
     pub light_media: Vec<crate::medium::MediumInterface>,
     /// Active dimensions of the rendering space.
     pub dims: Dims,
@@ -239,7 +239,12 @@ struct Builder<'a> {
     /// The media around each light.
     light_media: Vec<crate::medium::MediumInterface>,
     /// Area lights waiting for the world's bounds: (light description, surface index).
-    area_lights: Vec<(Arc<PluginDesc>, PrimKind, u32)>,
+    area_lights: Vec<(
+        Arc<PluginDesc>,
+        PrimKind,
+        u32,
+        crate::medium::MediumInterface,
+    )>,
 }
 
 impl<'a> Builder<'a> {
