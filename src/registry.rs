@@ -118,10 +118,10 @@ fn resolve<'a, B>(
     Ok(entry)
 }
 
-/// pbrt-v3's `bdpt` and `mlt` render participating media (acr's `bdpt`, and so `mlt`, whose
-/// paths are bdpt's, do not yet): on a scene that has some, their nearest in acr is `volpath`.
+/// pbrt-v3's `mlt` renders participating media, acr's does not yet: on a scene that has
+/// some, its nearest in acr is `volpath`. `bdpt` renders media itself (docs/light-transport.md).
 fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<Warning>) {
-    if desc.media.is_empty() || !matches!(choice.name.as_str(), "bdpt" | "mlt") {
+    if desc.media.is_empty() || choice.name != "mlt" {
         return;
     }
     let message = format!(
@@ -138,7 +138,7 @@ fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<
 
 /// pbrt-v3's warning for a scene with media rendered by an integrator that ignores them.
 fn media_warning(desc: &SceneDescription, integrator: &Integrator, warnings: &mut Vec<Warning>) {
-    if desc.media.is_empty() || matches!(integrator, Integrator::VolPath(_)) {
+    if desc.media.is_empty() || matches!(integrator, Integrator::VolPath(_) | Integrator::Bdpt(_)) {
         return;
     }
     let message = format!(
@@ -313,8 +313,8 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrators bdpt and mlt -> volpath on a scene \
-         with media.\n",
+         lowdiscrepancy, maxmindist -> sobol; integrator mlt -> volpath on a scene with \
+         media.\n",
     );
     out
 }

@@ -411,3 +411,85 @@ fn bdpt_with_many_lights_weighs_each_strategys_light_choice() {
         assert!((m - 1.0).abs() < 0.01, "{strategy}: {m}");
     }
 }
+
+/// A scene of scenes/pbrt-v3 written for `volpath`, rendered by `bdpt` with the parameters
+/// `extra`, after `edit` (pairs of text to replace) and at `resolution` (the same view).
+fn as_bdpt(name: &str, extra: &str, edit: &[(&str, &str)], resolution: u32) -> SceneDescription {
+    let path = root().join("scenes/pbrt-v3").join(name);
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    let bdpt = format!("Integrator \"bdpt\" {extra}");
+    let film =
+        format!("\"integer xresolution\" [{resolution}] \"integer yresolution\" [{resolution}]");
+    for (from, to) in [
+        ("Integrator \"volpath\"", bdpt.as_str()),
+        (
+            "\"integer xresolution\" [96] \"integer yresolution\" [96]",
+            &film,
+        ),
+    ]
+    .iter()
+    .chain(edit)
+    {
+        assert!(text.contains(from), "{name}: no {from}");
+        text = text.replace(from, to);
+    }
+    parse_str(&text, &path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Participating media (docs/media.md): a sphere of scattering medium behind an interface
+/// and a sphere of milk under an area light. bdpt's image mean is within 1% of pbrt-v3's
+/// converged volpath render, its MSE within 1.3x pbrt-v3's bdpt at 16 spp.
+#[test]
+fn bdpt_renders_homogeneous_media_as_pbrt_v3() {
+    let desc = as_bdpt("media-homogeneous.pbrt", "", &[], 96);
+    let reference = read_reference("media-homogeneous-ref1024.exr");
+    let pbrt16 = read_reference("media-homogeneous-bdpt-pbrt16.exr");
+    let (img, _) = render_desc(&desc, 16, 11);
+    let m = mean_lum(&img) / mean_lum(&reference);
+    let (mse, pbrt_mse) = (srgb8_mse(&img, &reference), srgb8_mse(&pbrt16, &reference));
+    eprintln!(
+        "homogeneous media: mean ratio {m:.4}; acr MSE {mse:.3e}, pbrt-v3 bdpt {pbrt_mse:.3e}"
+    );
+    assert!((m - 1.0).abs() < 0.01, "mean ratio {m}");
+    assert!(mse <= 1.3 * pbrt_mse, "{mse:.3e} vs {pbrt_mse:.3e}");
+}
+
+/// A spot light's cone in fog, the camera in the fog. The scene declares its lights in the
+/// fog although they hang above it (pbrt-v3 gives a light the outside medium in effect): light
+/// subpaths start in the fog, shadow rays from below reach them through vacuum, so pbrt-v3's
+/// bdpt and volpath disagree (by 1.5% in the mean) and bdpt's image depends on how its
+/// strategies are weighed. With pbrt-v3's light choice (power) acr's bdpt is within 1% of
+/// pbrt-v3's bdpt (256 spp), its MSE within 1.3x pbrt-v3's at 16 spp; with the lights put in
+/// vacuum, where they are, within 1% of pbrt-v3's volpath (at half the resolution, the same
+/// view).
+#[test]
+fn bdpt_renders_a_spot_light_in_fog_as_pbrt_v3() {
+    let power = "\"string lightsamplestrategy\" \"power\"";
+    let desc = as_bdpt("media-fog-spot.pbrt", power, &[], 96);
+    let reference = read_reference("media-fog-spot-bdpt-pbrt256.exr");
+    let pbrt16 = read_reference("media-fog-spot-bdpt-pbrt16.exr");
+    let (img, _) = render_desc(&desc, 16, 11);
+    let (mse, pbrt_mse) = (srgb8_mse(&img, &reference), srgb8_mse(&pbrt16, &reference));
+    let (img, _) = render_desc(&desc, 64, 12);
+    let m = mean_lum(&img) / mean_lum(&reference);
+    eprintln!(
+        "fog, lights in fog: mean ratio {m:.4}; acr MSE {mse:.3e}, pbrt-v3 bdpt {pbrt_mse:.3e}"
+    );
+    assert!((m - 1.0).abs() < 0.01, "mean ratio {m}");
+    assert!(mse <= 1.3 * pbrt_mse, "{mse:.3e} vs {pbrt_mse:.3e}");
+    let lights_in_vacuum = [
+        (
+            "LightSource \"spot\"",
+            "MediumInterface \"\" \"\"\nLightSource \"spot\"",
+        ),
+        (
+            "AttributeBegin\n  MediumInterface \"fog\" \"\"",
+            "MediumInterface \"\" \"fog\"\nAttributeBegin\n  MediumInterface \"fog\" \"\"",
+        ),
+    ];
+    let desc = as_bdpt("media-fog-spot.pbrt", "", &lights_in_vacuum, 48);
+    let reference = read_reference("media-fog-spot-ref1024.exr");
+    let m = mean_lum(&render_desc(&desc, 64, 13).0) / mean_lum(&reference);
+    eprintln!("fog, lights in vacuum: mean ratio {m:.4} of volpath's");
+    assert!((m - 1.0).abs() < 0.01, "mean ratio {m}");
+}

@@ -16,7 +16,7 @@ use crate::lightdistrib::LightStrategy;
 use crate::medium::{HenyeyGreenstein, MediumInterface};
 use crate::sampling::power_heuristic;
 use crate::scene::{Scene, SceneHit, Surface};
-use crate::stream::SampleStream;
+use crate::stream::{SampleSource, SampleStream};
 
 /// `volpath`'s settings.
 #[derive(Clone, Copy, Debug)]
@@ -31,9 +31,11 @@ pub struct VolPathSettings {
 
 /// A ray and the medium it travels in (`None`: vacuum).
 #[derive(Clone, Copy, Debug)]
-struct MediumRay {
-    ray: Ray,
-    medium: Option<u32>,
+pub(super) struct MediumRay {
+    /// The ray.
+    pub(super) ray: Ray,
+    /// The medium it travels in.
+    pub(super) medium: Option<u32>,
 }
 
 /// Where a path scatters: a surface with its BSDF, or a point in a medium with its phase
@@ -165,7 +167,7 @@ impl Vertex<'_> {
 /// The surface's media as seen by a ray in `medium`: its own where it is a transition, else
 /// `medium` on both sides (pbrt-v3's `GeometricPrimitive::Intersect`).
 #[inline]
-fn media_at(surface: &Surface, medium: Option<u32>) -> MediumInterface {
+pub(super) fn media_at(surface: &Surface, medium: Option<u32>) -> MediumInterface {
     surface.media.unwrap_or(MediumInterface {
         inside: medium,
         outside: medium,
@@ -197,7 +199,7 @@ fn continue_from(
 /// A ray's closest hit before its interaction is computed (which a path that scatters in a
 /// medium first, or a shadow ray that is blocked, never needs).
 #[derive(Clone, Copy)]
-struct RawHit {
+pub(super) struct RawHit {
     hit: Hit,
     surface: Surface,
 }
@@ -225,12 +227,12 @@ fn intersect(scene: &Scene, ray: &Ray, t_max: f32) -> Option<RawHit> {
 
 /// Transmittance through `medium` along `ray` up to `t_max`.
 #[inline]
-fn medium_tr(
+fn medium_tr<S: SampleSource + ?Sized>(
     scene: &Scene,
     medium: Option<u32>,
     ray: &Ray,
     t_max: f32,
-    stream: &mut SampleStream,
+    stream: &mut S,
 ) -> Spectrum {
     match medium {
         Some(m) => scene.media[m as usize].tr(ray, t_max, &mut || stream.next_1d()),
@@ -241,8 +243,10 @@ fn medium_tr(
 /// Where a ray that crosses interface surfaces goes on from each: along its own direction, or
 /// (a shadow ray) towards a fixed point.
 #[derive(Clone, Copy)]
-enum Toward {
+pub(super) enum Toward {
+    /// Along the ray's direction.
     Along,
+    /// Towards this point (a shadow ray).
     Point(Vec3),
 }
 
@@ -253,12 +257,12 @@ enum Toward {
 /// medium, and as soon as the transmittance is zero (pbrt-v3's `VisibilityTester::Tr`); a
 /// ray `Toward::Along` measures on (pbrt-v3's `Scene::IntersectTr`). The crossings need only
 /// the point and normal ([`crate::accel::Accel::crossing`]).
-fn cross_interfaces(
+pub(super) fn cross_interfaces<S: SampleSource + ?Sized>(
     scene: &Scene,
     mut mr: MediumRay,
     mut t_max: f32,
     toward: Toward,
-    stream: &mut SampleStream,
+    stream: &mut S,
     rays: &mut u32,
 ) -> (Option<(RawHit, Ray)>, Spectrum) {
     let shadow = matches!(toward, Toward::Point(_));

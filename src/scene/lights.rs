@@ -15,7 +15,7 @@ impl Builder<'_> {
     /// The area lights of the world's shapes, one per primitive of positive area that emits,
     /// each attached to its primitive's surface (`accel` placed, so that areas are final).
     pub(super) fn add_area_lights(&mut self, accel: &Accel) -> Result<()> {
-        for (light, kind, surface) in std::mem::take(&mut self.area_lights) {
+        for (light, kind, surface, media) in std::mem::take(&mut self.area_lights) {
             if !matches!(light.kind.as_str(), "area" | "diffuse") {
                 return Err(Error::at(
                     &light.loc,
@@ -39,6 +39,7 @@ impl Builder<'_> {
                     area,
                 });
                 self.light_samples.push(samples);
+                self.light_media.push(media);
                 self.surfaces[surface as usize].area_light = Some((self.lights.len() - 1) as u32);
             }
         }
@@ -58,6 +59,11 @@ impl Builder<'_> {
             };
             self.lights.push(light);
             self.light_samples.push(samples);
+            let outside = l.media.outside.map(|m| m as u32);
+            self.light_media.push(crate::medium::MediumInterface {
+                inside: outside,
+                outside,
+            });
         }
         Ok(())
     }

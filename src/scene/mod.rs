@@ -59,6 +59,10 @@ pub struct Scene {
     pub media: Vec<crate::medium::Medium>,
     /// The medium the camera sits in (`None`: vacuum).
     pub camera_medium: Option<u32>,
+    /// The media around each light, by light index (what bdpt's light subpaths start in): a
+    /// `LightSource`'s is the interface's outside medium on both sides, an area light's its
+    /// shape's `MediumInterface` (pbrt-v3's).
+    pub light_media: Vec<crate::medium::MediumInterface>,
     /// Active dimensions of the rendering space.
     pub dims: Dims,
     /// Centre of the scene's bounding sphere.
@@ -232,8 +236,15 @@ struct Builder<'a> {
     surfaces: Vec<Surface>,
     lights: Vec<Light>,
     light_samples: Vec<u32>,
+    /// The media around each light.
+    light_media: Vec<crate::medium::MediumInterface>,
     /// Area lights waiting for the world's bounds: (light description, surface index).
-    area_lights: Vec<(Arc<PluginDesc>, PrimKind, u32)>,
+    area_lights: Vec<(
+        Arc<PluginDesc>,
+        PrimKind,
+        u32,
+        crate::medium::MediumInterface,
+    )>,
 }
 
 impl<'a> Builder<'a> {
@@ -251,6 +262,7 @@ impl<'a> Builder<'a> {
             surfaces: Vec::new(),
             lights: Vec::new(),
             light_samples: Vec::new(),
+            light_media: Vec::new(),
             area_lights: Vec::new(),
         }
     }
@@ -392,6 +404,7 @@ impl Scene {
             light_choice: LightChoices::new(&b.lights, (lo, hi)),
             lights: b.lights,
             light_samples: b.light_samples,
+            light_media: b.light_media,
             infinite_lights,
             materials,
             surfaces: b.surfaces,

@@ -135,7 +135,12 @@ impl Builder<'_> {
             area_light: None,
             media,
         };
-        self.add_surfaces(geom, prims, surface, area_light);
+        // An area light's own media, as declared (what its light subpaths start in).
+        let declared = crate::medium::MediumInterface {
+            inside: inside.map(|m| m as u32),
+            outside: outside.map(|m| m as u32),
+        };
+        self.add_surfaces(geom, prims, surface, area_light.map(|l| (l, declared)));
         Ok(())
     }
 
@@ -397,9 +402,9 @@ impl Builder<'_> {
         geom: &mut Geometry,
         prims: Vec<PrimKind>,
         surface: Surface,
-        area_light: Option<&Arc<PluginDesc>>,
+        area_light: Option<(&Arc<PluginDesc>, crate::medium::MediumInterface)>,
     ) {
-        let Some(light) = area_light else {
+        let Some((light, media)) = area_light else {
             let surface = self.surface(surface);
             for kind in prims {
                 geom.push(Prim { kind, surface });
@@ -409,7 +414,8 @@ impl Builder<'_> {
         for kind in prims {
             // One light per primitive, as pbrt-v3 makes one DiffuseAreaLight per shape.
             let surface = self.surface(surface);
-            self.area_lights.push((Arc::clone(light), kind, surface));
+            self.area_lights
+                .push((Arc::clone(light), kind, surface, media));
             geom.push(Prim { kind, surface });
         }
     }

@@ -1,6 +1,7 @@
 //! Connecting a light subpath's first s vertices to a camera subpath's first t (pbrt-v3's
 //! `ConnectBDPT`, `G` and `MISWeight`).
 
+use super::super::volpath::{cross_interfaces, MediumRay, Toward};
 use super::vertex::{Mode, Vertex, VertexKind};
 use super::LightChoice;
 use crate::geometry::{Spectrum, Vec2};
@@ -33,6 +34,42 @@ fn unoccluded(scene: &Scene, a: &Vertex, b: &Vertex) -> bool {
                 .accel
                 .occluded(&ray, 1.0 - crate::geometry::SHADOW_EPSILON)
         }
+    }
+}
+
+/// The transmittance from `a` to `b` (pbrt-v3's `VisibilityTester::Tr`): zero when a
+/// surface with a material blocks the segment; through media and across interface surfaces
+/// (`Material ""`), which may change the medium, as volpath's shadow rays. Without media in
+/// the scene, plain visibility (the shadow ray of a surface-only scene, unchanged).
+fn transmittance<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    a: &Vertex,
+    b: &Vertex,
+    sampler: &mut S,
+) -> Spectrum {
+    if scene.media.is_empty() {
+        return if unoccluded(scene, a, b) {
+            Spectrum::ONE
+        } else {
+            Spectrum::ZERO
+        };
+    }
+    // From `a`, as pbrt-v3's `VisibilityTester` (a scene's media need not agree on which
+    // side a light is: the light subpath's medium, say, is its declared one).
+    let (from, to) = (a, b);
+    let (ray, t_max) = match &from.surface {
+        Some(s) => s.si.spawn_ray_to(to.p),
+        None => (
+            crate::geometry::Ray::new(from.p, to.p - from.p, from.time),
+            1.0 - crate::geometry::SHADOW_EPSILON,
+        ),
+    };
+    let medium = from.medium_toward(scene, ray.d);
+    let mr = MediumRay { ray, medium };
+    let mut rays = 0;
+    match cross_interfaces(scene, mr, t_max, Toward::Point(to.p), sampler, &mut rays) {
+        (Some(_), _) => Spectrum::ZERO,
+        (None, tr) => tr,
     }
 }
 
@@ -90,9 +127,7 @@ pub fn connect<S: SampleSource + ?Sized>(
                     }
                     if l != Spectrum::ZERO {
                         c.traced = true;
-                        if !unoccluded(scene, qs, &v) {
-                            l = Spectrum::ZERO;
-                        }
+                        l *= transmittance(scene, qs, &v, sampler);
                     }
                     c.raster = Some(i.raster);
                     sampled = Some(v);
@@ -111,9 +146,7 @@ pub fn connect<S: SampleSource + ?Sized>(
                 }
                 if l != Spectrum::ZERO {
                     c.traced = true;
-                    if !unoccluded(scene, pt, &v) {
-                        l = Spectrum::ZERO;
-                    }
+                    l *= transmittance(scene, pt, &v, sampler);
                 }
                 sampled = Some(v);
             }
@@ -125,8 +158,8 @@ pub fn connect<S: SampleSource + ?Sized>(
             if l != Spectrum::ZERO {
                 l *= geometry_term(qs, pt);
                 c.traced = true;
-                if l != Spectrum::ZERO && !unoccluded(scene, qs, pt) {
-                    l = Spectrum::ZERO;
+                if l != Spectrum::ZERO {
+                    l *= transmittance(scene, qs, pt, sampler);
                 }
             }
         }

@@ -255,9 +255,14 @@ pub fn bdpt_li<S: SampleSource + ?Sized>(
         let mut probe = FirstHitProbe::default();
         for w in camera.windows(2) {
             probe.travel(w[0].p, w[1].p);
-            match &w[1].surface {
-                Some(s) => probe.surface(&s.si, &s.bsdf),
-                None => break,
+            match (&w[1].surface, w[1].media.inside) {
+                (Some(s), _) => probe.surface(&s.si, &s.bsdf),
+                // A medium vertex: the medium's albedo, as volpath's first hit.
+                (None, Some(m)) if w[1].kind == VertexKind::Medium => {
+                    probe.medium(scene.media[m as usize].albedo());
+                    break;
+                }
+                _ => break,
             }
         }
         let mut shown = Vec::new();

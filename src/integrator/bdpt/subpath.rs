@@ -52,6 +52,7 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
         pdf: pdf_dir,
         max_depth: max_depth - 1,
         mode: Mode::Radiance,
+        medium: scene.camera_medium,
     };
     random_walk(scene, ray, diff, sampler, walk, path) + 1
 }
@@ -100,6 +101,7 @@ pub fn generate_light_subpath<S: SampleSource + ?Sized>(
         pdf: e.pdf_dir,
         max_depth: max_depth - 1,
         mode: Mode::Importance,
+        medium: path[0].medium_toward(scene, e.d),
     };
     let n_walk = random_walk(scene, Ray::new(o, e.d, time), None, sampler, walk, path);
     // Infinite lights: the first surface's density is the disk's, and the light's that of
@@ -128,11 +130,14 @@ struct Walk {
     max_depth: usize,
     /// Radiance (camera) or importance (light).
     mode: Mode,
+    /// The medium the first ray travels in.
+    medium: Option<u32>,
 }
 
-/// pbrt-v3's `RandomWalk` (without media, and without Russian roulette, as pbrt-v3's bdpt):
-/// adds up to `walk.max_depth` vertices to `path` (which holds the start) and returns how
-/// many.
+/// pbrt-v3's `RandomWalk` (without Russian roulette, as pbrt-v3's bdpt): adds up to
+/// `walk.max_depth` vertices to `path` (which holds the start) and returns how many. A ray in
+/// a medium may scatter before the surface it would hit: a medium vertex, its phase function
+/// sampled for the next direction (docs/media.md).
 fn random_walk<S: SampleSource + ?Sized>(
     scene: &Scene,
     mut ray: Ray,
@@ -149,12 +154,45 @@ fn random_walk<S: SampleSource + ?Sized>(
         pdf,
         max_depth,
         mode,
+        mut medium,
     } = walk;
     let mut pdf_fwd = pdf;
     let mut bounces = 0;
     let mut pass_through = 0;
     loop {
-        let Some(hit) = scene.intersect(&ray) else {
+        let raw = scene.accel.intersect(&ray, f32::INFINITY);
+        if let Some(m) = medium {
+            let t_hit = raw.map_or(f32::INFINITY, |h| h.t);
+            let ms = scene.media[m as usize].sample(&ray, t_hit, &mut || sampler.next_1d());
+            beta *= ms.weight;
+            if beta == Spectrum::ZERO || !crate::geometry::is_valid_radiance(beta) {
+                break;
+            }
+            if let Some(t) = ms.t {
+                let wo = -ray.d.normalize();
+                let phase = scene.media[m as usize].phase;
+                let at = (ray.at(t), wo, ray.time);
+                let prev = path.len() - 1;
+                let v = Vertex::medium(at, phase, medium, beta, pdf_fwd, &path[prev], scene);
+                path.push(v);
+                bounces += 1;
+                if bounces >= max_depth {
+                    break;
+                }
+                let (wi, p) = phase.sample_p(wo, sampler.next_2d());
+                pdf_fwd = p;
+                let n = path.len();
+                let rev = path[n - 1].convert_density(p, &path[n - 2], scene);
+                path[n - 2].pdf_rev = rev;
+                ray = Ray::new(ray.at(t), wi, ray.time);
+                continue;
+            }
+        }
+        let hit = raw.map(|h| crate::scene::SceneHit {
+            si: scene.accel.interaction(&ray, &h),
+            surface: scene.surfaces[h.prim.surface as usize],
+        });
+        let Some(hit) = hit else {
             // Camera rays that escape end on the infinite lights.
             if mode == Mode::Radiance {
                 let d = ray.d.normalize();
@@ -175,9 +213,12 @@ fn random_walk<S: SampleSource + ?Sized>(
             if pass_through > MAX_PASS_THROUGH {
                 break;
             }
+            let media = super::super::volpath::media_at(&hit.surface, medium);
+            medium = media.toward(si.n, ray.d);
             ray = si.spawn_ray(ray.d);
             continue;
         };
+        let media = super::super::volpath::media_at(&hit.surface, medium);
         let material = &scene.materials[material as usize];
         let si = material.shading(&si);
         let bsdf = material.bsdf(&si);
@@ -185,7 +226,7 @@ fn random_walk<S: SampleSource + ?Sized>(
         let point = SurfacePoint { si, bsdf };
         let vertex = Vertex::surface(
             point,
-            hit.surface.area_light,
+            (hit.surface.area_light, media),
             beta,
             pdf_fwd,
             &path[prev],
@@ -215,6 +256,7 @@ fn random_walk<S: SampleSource + ?Sized>(
         let mut pdf_rev = bsdf.pdf(s.wi, wo);
         beta *= correct_shading_normal(si, wo, s.wi, mode);
         let next_ray = si.spawn_ray(s.wi);
+        medium = media.toward(si.n, s.wi);
         if s.specular {
             pdf_rev = 0.0;
             pdf_fwd = 0.0;

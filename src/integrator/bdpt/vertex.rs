@@ -5,6 +5,7 @@ use super::LightChoice;
 use crate::bsdf::{Bsdf, Bxdf};
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec3};
 use crate::light::{Light, WorldSphere};
+use crate::medium::{HenyeyGreenstein, MediumInterface};
 use crate::scene::Scene;
 
 /// Which way a subpath carries light (pbrt-v3's `TransportMode`).
@@ -25,6 +26,8 @@ pub enum VertexKind {
     Light,
     /// A surface.
     Surface,
+    /// A scattering point in a participating medium.
+    Medium,
 }
 
 /// A surface vertex's scattering.
@@ -62,6 +65,12 @@ pub struct Vertex {
     pub light: Option<u32>,
     /// A surface's scattering.
     pub surface: Option<SurfacePoint>,
+    /// A medium vertex's phase function and the direction it was reached from (pointing back).
+    pub phase: Option<(HenyeyGreenstein, Vec3)>,
+    /// The media on either side: a surface's (both the ray's medium on a surface that is no
+    /// transition), a medium vertex's medium on both; unused by the endpoints, whose media are
+    /// the camera's and the lights' ([`Vertex::medium_toward`]).
+    pub media: MediumInterface,
 }
 
 /// pbrt-v3's `CorrectShadingNormal`: the adjoint BSDF's correction for shading normals in
@@ -166,13 +175,15 @@ impl Vertex {
             pdf_rev: 0.0,
             light,
             surface: None,
+            phase: None,
+            media: MediumInterface::default(),
         }
     }
 
     /// A surface vertex reached from `prev` with solid-angle density `pdf`.
     pub fn surface(
         point: SurfacePoint,
-        light: Option<u32>,
+        (light, media): (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,
         prev: &Vertex,
@@ -191,9 +202,57 @@ impl Vertex {
             pdf_rev: 0.0,
             light,
             surface: Some(point),
+            phase: None,
+            media,
         };
         v.pdf_fwd = prev.convert_density(pdf, &v, scene);
         v
+    }
+
+    /// A scattering point `p` in `medium` (phase function `phase`), reached along `-wo` from
+    /// `prev` with solid-angle density `pdf` (pbrt-v3's `CreateMedium`).
+    pub fn medium(
+        (p, wo, time): (Vec3, Vec3, f32),
+        phase: HenyeyGreenstein,
+        medium: Option<u32>,
+        beta: Spectrum,
+        pdf: f32,
+        prev: &Vertex,
+        scene: &Scene,
+    ) -> Self {
+        let mut v = Self {
+            kind: VertexKind::Medium,
+            beta,
+            p,
+            ng: Vec3::ZERO,
+            ns: Vec3::ZERO,
+            time,
+            delta: false,
+            pdf_fwd: 0.0,
+            pdf_rev: 0.0,
+            light: None,
+            surface: None,
+            phase: Some((phase, wo)),
+            media: MediumInterface {
+                inside: medium,
+                outside: medium,
+            },
+        };
+        v.pdf_fwd = prev.convert_density(pdf, &v, scene);
+        v
+    }
+
+    /// The medium a ray leaving this vertex along `d` travels in (pbrt-v3's
+    /// `Interaction::GetMedium`): the camera's, a light's, or the vertex's own.
+    pub fn medium_toward(&self, scene: &Scene, d: Vec3) -> Option<u32> {
+        match self.kind {
+            VertexKind::Camera => scene.camera_medium,
+            VertexKind::Light => self
+                .light
+                .and_then(|i| scene.light_media.get(i as usize))
+                .and_then(|m| m.toward(self.ng, d)),
+            VertexKind::Surface | VertexKind::Medium => self.media.toward(self.ng, d),
+        }
     }
 
     /// Whether it lies on a surface (a non-zero normal).
@@ -234,18 +293,22 @@ impl Vertex {
                 .surface
                 .as_ref()
                 .is_some_and(|s| s.bsdf.has_non_specular()),
+            VertexKind::Medium => true,
         }
     }
 
     /// The BSDF towards `next` (pbrt-v3's `Vertex::f`), for transport `mode`.
     pub fn f(&self, next: &Vertex, mode: Mode) -> Spectrum {
-        let Some(s) = &self.surface else {
-            return Spectrum::ZERO;
-        };
         let wi = (next.p - self.p).normalize_or_zero();
         if wi == Vec3::ZERO {
             return Spectrum::ZERO;
         }
+        if let Some((phase, wo)) = &self.phase {
+            return Spectrum::splat(phase.p(*wo, wi));
+        }
+        let Some(s) = &self.surface else {
+            return Spectrum::ZERO;
+        };
         let wo = s.si.wo;
         let f = s.bsdf.f(wo, wi);
         adjoint_f(&s.bsdf, &s.si, (wo, wi), f, false, mode)
@@ -290,6 +353,16 @@ impl Vertex {
                     return 0.0;
                 }
                 s.bsdf.pdf(wp, wn)
+            }
+            (VertexKind::Medium, _) => {
+                let (Some(prev), Some((phase, _))) = (prev, &self.phase) else {
+                    return 0.0;
+                };
+                let wp = (prev.p - self.p).normalize_or_zero();
+                if wp == Vec3::ZERO {
+                    return 0.0;
+                }
+                phase.p(wp, wn)
             }
             _ => 0.0,
         };
