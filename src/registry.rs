@@ -118,27 +118,14 @@ fn resolve<'a, B>(
     Ok(entry)
 }
 
-/// pbrt-v3's `mlt` renders participating media, acr's does not yet: on a scene that has
-/// some, its nearest in acr is `volpath`. `bdpt` renders media itself (docs/light-transport.md).
-fn media_alias(desc: &SceneDescription, choice: &mut Choice, warnings: &mut Vec<Warning>) {
-    if desc.media.is_empty() || choice.name != "mlt" {
-        return;
-    }
-    let message = format!(
-        "integrator \"{}\" renders no participating media yet; using \"volpath\", the nearest that renders the scene's \
-         participating media",
-        choice.name
-    );
-    warnings.push(match &choice.loc {
-        Some(l) => Warning::at(l, message),
-        None => Warning { loc: None, message },
-    });
-    choice.name = "volpath".to_owned();
-}
-
 /// pbrt-v3's warning for a scene with media rendered by an integrator that ignores them.
 fn media_warning(desc: &SceneDescription, integrator: &Integrator, warnings: &mut Vec<Warning>) {
-    if desc.media.is_empty() || matches!(integrator, Integrator::VolPath(_) | Integrator::Bdpt(_)) {
+    if desc.media.is_empty()
+        || matches!(
+            integrator,
+            Integrator::VolPath(_) | Integrator::Bdpt(_) | Integrator::Mlt(_)
+        )
+    {
         return;
     }
     let message = format!(
@@ -191,7 +178,6 @@ pub fn choose(
         "path",
         overrides.integrator.as_deref(),
     );
-    media_alias(desc, &mut ic, warnings);
     let ie: &Entry<IntegratorBuild> =
         resolve(INTEGRATORS, Kind::Integrator, &mut ic, overrides, warnings)?;
     let mut integrator = (ie.build)(&ic)?;
@@ -313,8 +299,7 @@ pub fn describe() -> String {
     }
     out.push_str(
         "pbrt-v3 names mapped to the nearest plugin, with a warning: samplers 02sequence, \
-         lowdiscrepancy, maxmindist -> sobol; integrator mlt -> volpath on a scene with \
-         media.\n",
+         lowdiscrepancy, maxmindist -> sobol.\n",
     );
     out
 }

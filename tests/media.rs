@@ -125,28 +125,52 @@ fn absorbing_sphere(integrator: &str) {
     );
 }
 
-/// pbrt-v3's `mlt` renders media, acr's not yet, so on a scene with media it maps to
-/// `volpath` (the same image), with a located warning; `bdpt` renders them itself, without
-/// a warning (tests/bdpt.rs checks its images); `sppm` renders and warns that it ignores them.
+/// `bdpt` and `mlt` (whose paths are bdpt's) render media themselves, as pbrt-v3's do:
+/// without a warning, an image of their own (tests/bdpt.rs checks bdpt's images, and
+/// `mlt_through_an_absorbing_sphere_keeps_the_transmittance` below mlt's mean); `sppm` renders
+/// and warns that it ignores them, as pbrt-v3's does.
 #[test]
-fn mlt_on_a_medium_scene_renders_as_volpath_and_bdpt_as_itself() {
+fn bdpt_and_mlt_render_media_themselves_and_sppm_warns() {
     let medium = "\"rgb sigma_a\" [0.25 0.5 1.5] \"rgb sigma_s\" [0.5 0.5 0.5]";
     let (_, volpath, _) = render_text(&sphere_scene(medium, "\"volpath\""), 8);
-    let (warnings, image, _) = render_text(&sphere_scene(medium, "\"mlt\""), 8);
-    assert_eq!(image, volpath);
-    assert_eq!(warnings.len(), 1, "{warnings:?}");
-    let w = &warnings[0];
-    assert!(w.message.contains("volpath") && w.loc.is_some(), "{w:?}");
-    let (warnings, image, _) = render_text(&sphere_scene(medium, "\"bdpt\""), 8);
-    assert!(warnings.is_empty(), "{warnings:?}");
-    assert_ne!(image, volpath);
-    // sppm renders, ignoring the media as pbrt-v3's does, and says so.
+    for integrator in ["\"bdpt\"", MLT_SMALL] {
+        let (warnings, image, _) = render_text(&sphere_scene(medium, integrator), 8);
+        assert!(warnings.is_empty(), "{integrator}: {warnings:?}");
+        assert_ne!(image, volpath, "{integrator}");
+    }
     let (warnings, _, _) = render_text(&sphere_scene(medium, "\"sppm\""), 2);
     assert!(
         warnings
             .iter()
             .any(|w| w.message.contains("\"sppm\" integrator ignores them")),
         "{warnings:?}"
+    );
+}
+
+/// mlt with a bootstrap small enough for a debug build (its image's mean is the bootstrap's
+/// estimate `b`).
+const MLT_SMALL: &str =
+    "\"mlt\" \"integer bootstrapsamples\" [20000] \"integer chains\" [64] \"integer maxdepth\" [2]";
+
+/// Through an absorbing sphere mlt's image keeps the transmittance exp(-sigma_a * 2): every
+/// path it can find crosses the medium, so its colour is the transmittance's and its
+/// brightness the bootstrap's estimate, a mean of 20,000 paths a depth, each either 0 or the
+/// transmittance over the chance of passing (relative standard deviation about 1.2%).
+#[test]
+fn mlt_through_an_absorbing_sphere_keeps_the_transmittance() {
+    let medium = "\"rgb sigma_a\" [0.25 0.5 1.5] \"rgb sigma_s\" [0 0 0]";
+    let (warnings, image, dropped) = render_text(&sphere_scene(medium, MLT_SMALL), 16);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(dropped, 0);
+    let m = mean(&image);
+    let expected = Spectrum::new(0.5f32.exp().recip(), 1f32.exp().recip(), 3f32.exp().recip());
+    let ratio = m / expected;
+    // The brightness: four standard deviations of the bootstrap's estimate.
+    assert!((ratio.x - 1.0).abs() < 0.05, "{m} against {expected}");
+    // The colour: every path has the transmittance's.
+    assert!(
+        (ratio.y / ratio.x - 1.0).abs() < 0.01 && (ratio.z / ratio.x - 1.0).abs() < 0.01,
+        "{m} against {expected}"
     );
 }
 
