@@ -10,6 +10,7 @@ use acr::scene::Scene;
 use std::path::PathBuf;
 
 mod common;
+use common::images::srgb8_mse;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -58,25 +59,6 @@ fn window(p: &[Spectrum], width: usize, [x0, x1, y0, y1]: [usize; 4]) -> f64 {
         .flat_map(|y| (x0..x1).map(move |x| y * width + x))
         .map(|i| f64::from(acr::spectrum_luminance(p[i])))
         .sum()
-}
-
-/// MSE of 8-bit sRGB values, as tests/render.rs measures agreement.
-fn srgb8_mse(a: &[Spectrum], b: &[Spectrum]) -> f64 {
-    let q = |v: f32| -> f64 {
-        let v = v.clamp(0.0, 1.0);
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0).round() as f64 / 255.0
-    };
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| (q(x[c]) - q(y[c])).powi(2)).sum::<f64>())
-        .sum();
-    sum / (3 * a.len()) as f64
 }
 
 /// The caustic under the glass sphere of `caustic-point.pbrt`.

@@ -9,6 +9,9 @@ use acr::render::render;
 use acr::scene::Scene;
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::images::srgb8_mse;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -42,25 +45,6 @@ fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> (Vec<Spectrum>, 
 
 fn mean(p: &[Spectrum]) -> Spectrum {
     p.iter().copied().sum::<Spectrum>() / p.len() as f32
-}
-
-/// MSE of 8-bit sRGB values (as tests/render.rs's).
-fn srgb8_mse(a: &[Spectrum], b: &[Spectrum]) -> f64 {
-    let q = |v: f32| -> f64 {
-        let v = v.clamp(0.0, 1.0);
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0).round() as f64 / 255.0
-    };
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| (q(x[c]) - q(y[c])).powi(2)).sum::<f64>())
-        .sum();
-    sum / (3 * a.len()) as f64
 }
 
 /// At 16 spp, acr's MSE against pbrt-v3's converged render (`-ref1024`) is within 1.3x

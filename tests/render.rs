@@ -9,6 +9,9 @@ use acr::render::render;
 use acr::scene::Scene;
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::images::srgb8_mse;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -213,25 +216,6 @@ const PBRT_V3_MSE: &[(&str, &str, u32, f64)] = &[
     ),
     ("veach-mis/mis.pbrt", "mis-ref64.exr", 4, 1.9e-2),
 ];
-
-/// MSE of two images after pbrt's 8-bit sRGB conversion (clamp, gamma, round).
-fn srgb8_mse(a: &[Spectrum], b: &[Spectrum]) -> f64 {
-    let q = |v: f32| -> f64 {
-        let v = v.clamp(0.0, 1.0);
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0).round() as f64 / 255.0
-    };
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| (q(x[c]) - q(y[c])).powi(2)).sum::<f64>())
-        .sum();
-    sum / (3 * a.len()) as f64
-}
 
 /// Renders `desc` with the path integrator's light choice set to `strategy`.
 fn render_with_strategy(desc: &SceneDescription, strategy: &str, spp: u32, seed: u64) -> Rendered {

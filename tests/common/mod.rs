@@ -1,7 +1,10 @@
-//! What the farm tests share: a scratch folder per test, running the `acr` binary, and the
-//! scene they render.
+//! What the integration tests share: for the farm tests a scratch folder per test, running
+//! the `acr` binary and the scene they render; for the agreement tests the image measure
+//! (`images`).
 
 #![allow(dead_code)]
+
+pub mod images;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
