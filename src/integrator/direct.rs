@@ -8,7 +8,7 @@ use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::sampling::power_heuristic;
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneHit};
 use crate::stream::SampleStream;
 
 /// What a recursive estimate counts on its way: rays traced and the first-hit features.
@@ -33,28 +33,9 @@ pub(super) fn direct_li(
     strategy: DirectStrategy,
     tally: &mut Tally,
 ) -> Spectrum {
-    let mut ray = ray;
-    let mut pass_through = 0;
-    let hit = loop {
-        tally.rays += 1;
-        let hit = scene.intersect(&ray);
-        if let Some(h) = &hit {
-            tally.probe.travel(ray.o, h.si.p);
-        }
-        match hit {
-            None => {
-                return scene
-                    .infinite_lights
-                    .iter()
-                    .map(|&i| scene.lights[i as usize].le(ray.d.normalize()))
-                    .sum();
-            }
-            Some(h) if h.surface.material.is_none() && pass_through < MAX_PASS_THROUGH => {
-                pass_through += 1;
-                ray = h.si.spawn_ray(ray.d);
-            }
-            Some(h) => break h,
-        }
+    let (hit, pass_through) = match first_surface(scene, ray, tally) {
+        Ok(h) => h,
+        Err(sky) => return sky,
     };
     let mut si = hit.si;
     // The differentials hold for the ray as it left the camera (or a specular bounce), not
@@ -233,4 +214,37 @@ pub(super) fn estimate_direct(
     let w = power_heuristic(1.0, s.pdf, 1.0, light_pdf * choice_pdf);
     ld += f * li * w / (s.pdf * choice_pdf);
     ld
+}
+
+/// The first surface along `ray` that has a material, passing through interfaces (`Material
+/// ""`, at most [`MAX_PASS_THROUGH`] of them; the one after is taken as the surface), with the
+/// number passed; `Err` with the infinite lights' radiance when the ray leaves the scene.
+/// Shared by `directlighting` and `whitted`.
+pub(super) fn first_surface(
+    scene: &Scene,
+    mut ray: Ray,
+    tally: &mut Tally,
+) -> Result<(SceneHit, u32), Spectrum> {
+    let mut pass_through = 0;
+    loop {
+        tally.rays += 1;
+        let hit = scene.intersect(&ray);
+        if let Some(h) = &hit {
+            tally.probe.travel(ray.o, h.si.p);
+        }
+        match hit {
+            None => {
+                return Err(scene
+                    .infinite_lights
+                    .iter()
+                    .map(|&i| scene.lights[i as usize].le(ray.d.normalize()))
+                    .sum());
+            }
+            Some(h) if h.surface.material.is_none() && pass_through < MAX_PASS_THROUGH => {
+                pass_through += 1;
+                ray = h.si.spawn_ray(ray.d);
+            }
+            Some(h) => return Ok((h, pass_through)),
+        }
+    }
 }

@@ -3,8 +3,7 @@
 //! transmission followed recursively to `maxdepth`, the camera ray's differentials carried
 //! through them (docs/light-transport.md).
 
-use super::direct::{specular_differentials, Tally};
-use super::MAX_PASS_THROUGH;
+use super::direct::{first_surface, specular_differentials, Tally};
 use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
@@ -19,33 +18,11 @@ pub fn whitted_li(
     depth: u32,
     tally: &mut Tally,
 ) -> Spectrum {
-    let mut ray = ray;
-    let mut pass_through = 0;
     // A surface without material passes the ray on at the same depth, without emission, as
     // pbrt-v3's recursion does.
-    let hit = loop {
-        tally.rays += 1;
-        let hit = scene.intersect(&ray);
-        if let Some(h) = &hit {
-            tally.probe.travel(ray.o, h.si.p);
-        }
-        match hit {
-            None => {
-                return scene
-                    .infinite_lights
-                    .iter()
-                    .map(|&i| scene.lights[i as usize].le(ray.d.normalize()))
-                    .sum();
-            }
-            Some(h) if h.surface.material.is_none() => {
-                pass_through += 1;
-                if pass_through > MAX_PASS_THROUGH {
-                    return Spectrum::ZERO;
-                }
-                ray = h.si.spawn_ray(ray.d);
-            }
-            Some(h) => break h,
-        }
+    let (hit, pass_through) = match first_surface(scene, ray, tally) {
+        Ok(h) => h,
+        Err(sky) => return sky,
     };
     let mut si = hit.si;
     // The differentials hold for the ray as it left the camera or a specular bounce.
