@@ -5,12 +5,11 @@
 use acr::geometry::Spectrum;
 use acr::parser::{parse_file, parse_str, SceneDescription, Warning};
 use acr::registry::{choose_for_scene, Overrides};
-use acr::render::render;
 use acr::scene::Scene;
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::images::srgb8_mse;
+use common::in_process::{render_in_process, srgb8_mse};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -18,29 +17,9 @@ fn root() -> PathBuf {
 
 /// The image of `desc` at `spp` and `seed`, with the warnings of building it.
 fn render_desc(desc: &SceneDescription, spp: u32, seed: u64) -> (Vec<Spectrum>, Vec<Warning>) {
-    let mut warnings = desc.warnings.clone();
-    let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut plugins = choose_for_scene(
-        desc,
-        &scene,
-        &Overrides::default(),
-        Some(spp),
-        seed,
-        &mut warnings,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let mut film = plugins.film(&scene);
-    let counts = render(
-        &scene,
-        &plugins.integrator,
-        plugins.sampler.as_mut(),
-        &mut film,
-        seed,
-        None,
-        None,
-    );
-    assert_eq!(counts.dropped, 0);
-    (plugins.image(&film), warnings)
+    let r = render_in_process(desc, &Overrides::default(), Some(spp), seed);
+    assert_eq!(r.counts.dropped, 0);
+    (r.pixels, r.warnings)
 }
 
 fn mean(p: &[Spectrum]) -> Spectrum {

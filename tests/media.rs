@@ -5,9 +5,11 @@
 use acr::geometry::Spectrum;
 use acr::parser::{parse_str, SceneDescription, Warning};
 use acr::registry::{choose_for_scene, Overrides};
-use acr::render::render;
 use acr::scene::Scene;
 use std::path::Path;
+
+mod common;
+use common::in_process::render_in_process;
 
 fn parse(text: &str) -> SceneDescription {
     parse_str(text, Path::new("media.pbrt")).unwrap_or_else(|e| panic!("{e}"))
@@ -26,21 +28,8 @@ fn render_desc(
     spp: u32,
     seed: u64,
 ) -> (Vec<Warning>, Vec<Spectrum>, u64) {
-    let mut warnings = desc.warnings.clone();
-    let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut plugins = choose_for_scene(desc, &scene, overrides, Some(spp), seed, &mut warnings)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let mut film = plugins.film(&scene);
-    let counts = render(
-        &scene,
-        &plugins.integrator,
-        plugins.sampler.as_mut(),
-        &mut film,
-        seed,
-        None,
-        None,
-    );
-    (warnings, plugins.image(&film), counts.dropped)
+    let r = render_in_process(desc, overrides, Some(spp), seed);
+    (r.warnings, r.pixels, r.counts.dropped)
 }
 
 /// The error building `text` gives.

@@ -10,7 +10,7 @@ use acr::scene::Scene;
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::images::srgb8_mse;
+use common::in_process::{render_in_process, srgb8_mse};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -55,24 +55,11 @@ fn render_desc_with(
     spp: u32,
     seed: u64,
 ) -> Rendered {
-    let mut warnings = Vec::new();
-    let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut plugins = choose_for_scene(desc, &scene, overrides, Some(spp), seed, &mut warnings)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let mut film = plugins.film(&scene);
-    let counts = render(
-        &scene,
-        &plugins.integrator,
-        plugins.sampler.as_mut(),
-        &mut film,
-        seed,
-        None,
-        None,
-    );
+    let r = render_in_process(desc, overrides, Some(spp), seed);
     Rendered {
-        pixels: plugins.image(&film),
-        width: scene.film.size().0 as usize,
-        dropped: counts.dropped,
+        pixels: r.pixels,
+        width: r.width,
+        dropped: r.counts.dropped,
     }
 }
 

@@ -8,9 +8,11 @@ use acr::integrator::Integrator;
 use acr::light::emission::sample_le;
 use acr::parser::{parse_file, parse_str, SceneDescription};
 use acr::registry::{choose_for_scene, Overrides};
-use acr::render::render;
 use acr::scene::Scene;
 use std::path::{Path, PathBuf};
+
+mod common;
+use common::in_process::render_in_process;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -19,28 +21,8 @@ fn root() -> PathBuf {
 /// The image `desc` renders to with `spp` (sppm's iterations) and `seed`, with the samples
 /// dropped.
 fn render_desc(desc: &SceneDescription, spp: Option<u32>, seed: u64) -> (Vec<Spectrum>, u64) {
-    let mut warnings = Vec::new();
-    let scene = Scene::build(desc, &mut warnings).unwrap_or_else(|e| panic!("{e}"));
-    let mut plugins = choose_for_scene(
-        desc,
-        &scene,
-        &Overrides::default(),
-        spp,
-        seed,
-        &mut warnings,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let mut film = plugins.film(&scene);
-    let counts = render(
-        &scene,
-        &plugins.integrator,
-        plugins.sampler.as_mut(),
-        &mut film,
-        seed,
-        None,
-        None,
-    );
-    (plugins.image(&film), counts.dropped)
+    let r = render_in_process(desc, &Overrides::default(), spp, seed);
+    (r.pixels, r.counts.dropped)
 }
 
 fn mean_luminance(p: &[Spectrum]) -> f64 {

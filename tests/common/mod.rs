@@ -1,10 +1,10 @@
 //! What the integration tests share: for the farm tests a scratch folder per test, running
-//! the `acr` binary and the scene they render; for the agreement tests the image measure
-//! (`images`).
+//! the `acr` binary and the scene they render; for the agreement tests the render and the
+//! image measure (`in_process`).
 
 #![allow(dead_code)]
 
-pub mod images;
+pub mod in_process;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
