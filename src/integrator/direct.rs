@@ -90,36 +90,19 @@ pub(super) fn direct_li(
             }
         }
     }
-    // pbrt-v3's SpecularReflect and SpecularTransmit: every specular lobe is followed (a
-    // glass's reflection and its transmission both), each with its own sample.
     if depth + 1 < max_depth {
-        for index in 0..bsdf.num_lobes() {
-            let u = stream.next_2d();
-            let Some(s) = bsdf.sample_specular_lobe(si.wo, u, index) else {
-                continue;
-            };
-            let cos = s.wi.dot(si.shading_n).abs();
-            let weight = s.f * cos / s.pdf;
-            if cos == 0.0 || weight == Spectrum::ZERO || !crate::geometry::is_valid_radiance(weight)
-            {
-                continue;
-            }
-            let next = si.spawn_ray(s.wi);
-            let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
-            let next_diff =
-                camera_diff.map(|d| specular_differentials(d, &si, s.wi, transmitted, bsdf.eta()));
-            l += weight
-                * direct_li(
-                    scene,
-                    next,
-                    next_diff.as_ref(),
-                    stream,
-                    max_depth,
-                    depth + 1,
-                    strategy,
-                    tally,
-                );
-        }
+        l += follow_specular_lobes(&si, &bsdf, camera_diff, stream, |next, d, stream| {
+            direct_li(
+                scene,
+                next,
+                d,
+                stream,
+                max_depth,
+                depth + 1,
+                strategy,
+                tally,
+            )
+        });
     }
     l
 }
@@ -247,4 +230,35 @@ pub(super) fn first_surface(
             Some(h) => return Ok((h, pass_through)),
         }
     }
+}
+
+/// pbrt-v3's SpecularReflect and SpecularTransmit: every specular lobe of `bsdf` at `si` is
+/// followed (a glass's reflection and its transmission both), each with its own sample, the
+/// camera ray's differentials carried through; `trace` gives the radiance along each spawned
+/// ray. Shared by `directlighting` and `whitted`.
+pub(super) fn follow_specular_lobes(
+    si: &SurfaceInteraction,
+    bsdf: &crate::bsdf::Bsdf,
+    camera_diff: Option<&RayDifferentials>,
+    stream: &mut SampleStream,
+    mut trace: impl FnMut(Ray, Option<&RayDifferentials>, &mut SampleStream) -> Spectrum,
+) -> Spectrum {
+    let mut l = Spectrum::ZERO;
+    for index in 0..bsdf.num_lobes() {
+        let u = stream.next_2d();
+        let Some(s) = bsdf.sample_specular_lobe(si.wo, u, index) else {
+            continue;
+        };
+        let cos = s.wi.dot(si.shading_n).abs();
+        let weight = s.f * cos / s.pdf;
+        if cos == 0.0 || weight == Spectrum::ZERO || !crate::geometry::is_valid_radiance(weight) {
+            continue;
+        }
+        let next = si.spawn_ray(s.wi);
+        let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
+        let next_diff =
+            camera_diff.map(|d| specular_differentials(d, si, s.wi, transmitted, bsdf.eta()));
+        l += weight * trace(next, next_diff.as_ref(), stream);
+    }
+    l
 }

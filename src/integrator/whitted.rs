@@ -3,7 +3,7 @@
 //! transmission followed recursively to `maxdepth`, the camera ray's differentials carried
 //! through them (docs/light-transport.md).
 
-use super::direct::{first_surface, specular_differentials, Tally};
+use super::direct::{first_surface, follow_specular_lobes, Tally};
 use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
@@ -64,34 +64,10 @@ pub fn whitted_li(
             }
         }
     }
-    // pbrt-v3's SpecularReflect and SpecularTransmit: each specular lobe, its own sample.
     if depth + 1 < max_depth {
-        for index in 0..bsdf.num_lobes() {
-            let u = stream.next_2d();
-            let Some(s) = bsdf.sample_specular_lobe(si.wo, u, index) else {
-                continue;
-            };
-            let cos = s.wi.dot(si.shading_n).abs();
-            let weight = s.f * cos / s.pdf;
-            if cos == 0.0 || weight == Spectrum::ZERO || !crate::geometry::is_valid_radiance(weight)
-            {
-                continue;
-            }
-            let next = si.spawn_ray(s.wi);
-            let transmitted = s.wi.dot(si.n) * si.wo.dot(si.n) < 0.0;
-            let next_diff =
-                camera_diff.map(|d| specular_differentials(d, &si, s.wi, transmitted, bsdf.eta()));
-            l += weight
-                * whitted_li(
-                    scene,
-                    next,
-                    next_diff.as_ref(),
-                    stream,
-                    max_depth,
-                    depth + 1,
-                    tally,
-                );
-        }
+        l += follow_specular_lobes(&si, &bsdf, camera_diff, stream, |next, d, stream| {
+            whitted_li(scene, next, d, stream, max_depth, depth + 1, tally)
+        });
     }
     l
 }
