@@ -60,7 +60,12 @@ pub struct Camera {
     /// The film's full resolution (the environment camera's angles are fractions of it).
     resolution: (f32, f32),
     raster_to_camera: Mat4,
+    /// Its inverse, for importance (bdpt's and mlt's t = 1 strategies).
+    camera_to_raster: Mat4,
     world_from_camera: MotionTransform,
+    /// The inverse of `world_from_camera` when the camera does not move (computed once:
+    /// light tracing maps every connection to the film through it).
+    camera_from_world: Option<Mat4>,
     /// Thin-lens radius; 0 for a pinhole.
     pub lens_radius: f32,
     /// Distance to the plane in focus.
@@ -187,11 +192,16 @@ impl Camera {
             Projection::Realistic => Some(Arc::new(lens_system(desc, context, warnings)?)),
             _ => None,
         };
+        let world_from_camera = MotionTransform::new(&inverse_motion);
+        let camera_from_world =
+            (!world_from_camera.is_moving()).then(|| world_from_camera.at(0.0).inverse());
         Ok(Self {
             projection,
             resolution: (xres, yres),
             raster_to_camera,
-            world_from_camera: MotionTransform::new(&inverse_motion),
+            camera_to_raster: raster_to_camera.inverse(),
+            world_from_camera,
+            camera_from_world,
             lens_radius,
             focal_distance,
             shutter_open,

@@ -64,8 +64,9 @@ impl Camera {
             } else {
                 1.0
             }) / cos);
-        let pc = m.inverse().transform_point3(focus);
-        let pr = self.raster_to_camera.inverse() * pc.extend(1.0);
+        let camera_from_world = self.camera_from_world.unwrap_or_else(|| m.inverse());
+        let pc = camera_from_world.transform_point3(focus);
+        let pr = self.camera_to_raster * pc.extend(1.0);
         let r = Vec2::new(pr.x / pr.w, pr.y / pr.w);
         let inside = r.x >= 0.0 && r.x < self.resolution.0 && r.y >= 0.0 && r.y < self.resolution.1;
         inside.then_some((r, cos))

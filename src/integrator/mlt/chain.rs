@@ -75,13 +75,17 @@ fn bootstrap<F: PathContribution>(setup: &Setup<F>, tally: &mut Tally) -> Vec<f3
     let results: Vec<(f32, Tally)> = (0..n)
         .into_par_iter()
         .with_min_len(64)
-        .map(|index| {
-            let index = index as u64;
-            let mut t = Tally::default();
-            let depth = (index % u64::from(depths)) as u32;
-            let c = setup.eval(&mut setup.sampler(index), depth, &mut t);
-            (spectrum_luminance(c.l), t)
-        })
+        .map_init(
+            || setup.sampler(0),
+            |sampler, index| {
+                let index = index as u64;
+                let mut t = Tally::default();
+                let depth = (index % u64::from(depths)) as u32;
+                sampler.reset(setup.seed, index);
+                let c = setup.eval(sampler, depth, &mut t);
+                (spectrum_luminance(c.l), t)
+            },
+        )
         .collect();
     results
         .into_iter()

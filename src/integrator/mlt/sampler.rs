@@ -85,6 +85,18 @@ impl MltSampler {
         }
     }
 
+    /// Makes this sampler [`MltSampler::new`]'s for `seed` and `index`, keeping the allocation
+    /// of its coordinates (the bootstrap makes one sampler per path: a fresh vector each time
+    /// cost the reallocations of its growth).
+    pub fn reset(&mut self, seed: u64, index: u64) {
+        let mut x = std::mem::take(&mut self.x);
+        x.clear();
+        *self = Self {
+            x,
+            ..Self::new(seed, index, self.sigma, self.large_step_probability)
+        };
+    }
+
     /// Starts a proposal: a large step with the sampler's chance, else a small one.
     pub fn start_iteration(&mut self) {
         self.current_iteration += 1;
