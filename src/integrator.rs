@@ -102,6 +102,23 @@ pub struct Radiance {
 /// Builds an integrator from its checked parameters.
 pub type IntegratorBuild = fn(&Choice) -> Result<Integrator>;
 
+/// `maxdepth` of the integrators that count a path's bounces (`path`, `bdpt`, `mlt`).
+pub(super) const MAX_DEPTH_BOUNCES: ParamSpec = ParamSpec::new(
+    "maxdepth",
+    ParamType::Integer,
+    "5",
+    "longest path, in bounces",
+);
+
+/// `maxdepth` of the integrators that recurse only through specular lobes
+/// (`directlighting`, `whitted`).
+const MAX_DEPTH_SPECULAR: ParamSpec = ParamSpec::new(
+    "maxdepth",
+    ParamType::Integer,
+    "5",
+    "specular recursion depth",
+);
+
 /// `path`'s and `volpath`'s Russian roulette threshold.
 const RR_THRESHOLD: ParamSpec = ParamSpec::new(
     "rrthreshold",
@@ -126,12 +143,7 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
             name: "path",
             doc: "path tracing: light and BSDF sampling with MIS, Russian roulette (pbrt-v3 path)",
             params: &[
-                ParamSpec::new(
-                    "maxdepth",
-                    ParamType::Integer,
-                    "5",
-                    "longest path, in bounces",
-                ),
+                MAX_DEPTH_BOUNCES,
                 RR_THRESHOLD,
                 LIGHT_SAMPLE_STRATEGY,
             ],
@@ -162,12 +174,7 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
             name: "bdpt",
             doc: "bidirectional path tracing: every connection of a camera and a light subpath, MIS-weighted; light tracing splatted (pbrt-v3 bdpt)",
             params: &[
-                ParamSpec::new(
-                    "maxdepth",
-                    ParamType::Integer,
-                    "5",
-                    "longest path, in bounces",
-                ),
+                MAX_DEPTH_BOUNCES,
                 ParamSpec::new(
                     "lightsamplestrategy",
                     ParamType::String,
@@ -196,12 +203,7 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
             name: "directlighting",
             doc: "direct lighting plus specular reflection and refraction (pbrt-v3 directlighting)",
             params: &[
-                ParamSpec::new(
-                    "maxdepth",
-                    ParamType::Integer,
-                    "5",
-                    "specular recursion depth",
-                ),
+                MAX_DEPTH_SPECULAR,
                 ParamSpec::new(
                     "strategy",
                     ParamType::String,
@@ -240,12 +242,7 @@ pub static INTEGRATORS: &[Entry<IntegratorBuild>] = &[
             kind: Kind::Integrator,
             name: "whitted",
             doc: "Whitted ray tracing: every light sampled once, specular reflection and refraction followed (pbrt-v3 whitted)",
-            params: &[ParamSpec::new(
-                "maxdepth",
-                ParamType::Integer,
-                "5",
-                "specular recursion depth",
-            )],
+            params: &[MAX_DEPTH_SPECULAR],
         },
         build: Integrator::whitted,
     },

@@ -2,7 +2,7 @@
 //! the light, with the densities of its origin and of its direction) and `Light::Pdf_Le`, for
 //! bdpt's light subpaths and their MIS weights (docs/light-transport.md).
 
-use super::{area_emission, goniometric_scale, sample_area, Light};
+use super::{area_emission, goniometric_scale, sample_area, spot_falloff, Light};
 use crate::accel::Geometry;
 use crate::geometry::{offset_ray_origin, Frame, Ray, Spectrum, Vec2, Vec3};
 use crate::sampling::{
@@ -43,19 +43,6 @@ fn disk_point(center: Vec3, r: f32, d: Vec3, u: Vec2) -> Vec3 {
     let f = Frame::from_z(d);
     let cd = concentric_sample_disk(u);
     center + r * (cd.x * f.s + cd.y * f.t)
-}
-
-/// The spot light's falloff for the light-space direction `wl` (unit).
-fn spot_falloff(wl: Vec3, cos_total: f32, cos_falloff_start: f32) -> f32 {
-    let cos_theta = wl.z;
-    if cos_theta < cos_total {
-        0.0
-    } else if cos_theta >= cos_falloff_start {
-        1.0
-    } else {
-        let delta = (cos_theta - cos_total) / (cos_falloff_start - cos_total);
-        (delta * delta) * (delta * delta)
-    }
 }
 
 impl Light {

@@ -282,15 +282,7 @@ impl Light {
             } => {
                 let wi = (*pos - p).normalize();
                 let wl = light_from_world.transform_vector3(-wi).normalize();
-                let cos_theta = wl.z;
-                let falloff = if cos_theta < *cos_total {
-                    0.0
-                } else if cos_theta >= *cos_falloff_start {
-                    1.0
-                } else {
-                    let delta = (cos_theta - cos_total) / (cos_falloff_start - cos_total);
-                    (delta * delta) * (delta * delta)
-                };
+                let falloff = spot_falloff(wl, *cos_total, *cos_falloff_start);
                 if falloff == 0.0 {
                     return None;
                 }
@@ -660,6 +652,21 @@ impl Light {
             intensity,
             projection: ImageProjection::new(map, fov_degrees),
         })
+    }
+}
+
+/// pbrt-v3's spot falloff for the light-space direction `wl` (unit): 1 inside the falloff
+/// cone, 0 outside the total cone, a quartic of the cosines between. `sample_li` and
+/// `sample_le` share it.
+fn spot_falloff(wl: Vec3, cos_total: f32, cos_falloff_start: f32) -> f32 {
+    let cos_theta = wl.z;
+    if cos_theta < cos_total {
+        0.0
+    } else if cos_theta >= cos_falloff_start {
+        1.0
+    } else {
+        let delta = (cos_theta - cos_total) / (cos_falloff_start - cos_total);
+        (delta * delta) * (delta * delta)
     }
 }
 

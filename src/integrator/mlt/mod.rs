@@ -44,12 +44,7 @@ pub const ENTRY: Entry<IntegratorBuild> = Entry {
         name: "mlt",
         doc: "Metropolis light transport in primary sample space (pbrt-v3 mlt, over bdpt's paths)",
         params: &[
-            ParamSpec::new(
-                "maxdepth",
-                ParamType::Integer,
-                "5",
-                "longest path, in bounces",
-            ),
+            super::MAX_DEPTH_BOUNCES,
             ParamSpec::new(
                 "bootstrapsamples",
                 ParamType::Integer,
