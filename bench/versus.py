@@ -15,17 +15,23 @@ into pbrt-v4's light BVH, so acr renders such a scene with `lightsamplestrategy=
 comparison with pbrt-v4.
 
 usage: python3 bench/versus.py [--acr PATH] [--pbrt-v3 PATH] [--pbrt-v4 PATH] [--threads N]
-           [--runs N] [--spp N] [--scene FILE ...] [--large DIR] [--out FILE.md]
+           [--runs N] [--spp N] [--scene FILE ...] [--large DIR] [--no-interiors] [--startup]
+           [--out FILE.md]
 With --spp, every renderer reads a copy of the scene (beside it, removed afterwards) whose
-Sampler's "integer pixelsamples" is N.
+Sampler's "integer pixelsamples" is N; the interiors keep the spp of INTERIOR_SPP whatever --spp.
 Without --scene: scenes/*.pbrt, the pbrt-v3 scenes in ../shared/scenes/pbrt-v3 when present,
-and a 1M-triangle mesh written by bench/tools/make_large_scene.py into --large (default
-bench/cache/large). With --out, the table replaces the text between the markers
+a 1M-triangle mesh written by bench/tools/make_large_scene.py into --large (default
+bench/cache/large), and the interiors of bench/scenes/*.pbrt.gz (decompressed beside them for
+the renderers that read only text; --no-interiors leaves them out). With --startup, each
+renderer also renders one pixel of each scene (--pixelbounds 0,1,0,1, pbrt-v3 excepted: it has
+no such flag): that whole-process time is its start-up (parse, build, output), and the table
+gives it with its share of the full render's time. With --out, the table replaces the text between the markers
 <!-- versus:begin --> and <!-- versus:end --> in that file (appended when they are missing).
 Python 3 standard library only."""
 
 import argparse
 import glob
+import gzip
 import os
 import platform
 import re
@@ -38,6 +44,10 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LONG_RUN = 60.0
 BEGIN, END = "<!-- versus:begin -->", "<!-- versus:end -->"
+# The interiors render at the spp the benchmarks' history measured them at (a full 1000x676
+# frame each), whatever --spp asks of the small scenes.
+INTERIOR_SPP = {"conference_room": 8, "theater": 4}
+ONE_PIXEL = "0,1,0,1"
 
 
 def run(cmd):
@@ -111,6 +121,25 @@ def v4_work(original, v4):
     return (args, ", ".join(what)) if args else None
 
 
+def scene_name(path):
+    """The scene's name: its file name without `.pbrt` or `.pbrt.gz`."""
+    base = os.path.basename(path)
+    for suffix in [".pbrt.gz", ".pbrt"]:
+        if base.endswith(suffix):
+            return base[: -len(suffix)]
+    return base
+
+
+def decompressed(scene):
+    """A text copy of a `.pbrt.gz` scene beside it (pbrt-v3 reads only text); None for text."""
+    if not scene.endswith(".gz"):
+        return None
+    path = os.path.join(os.path.dirname(scene), f".versus-text-{scene_name(scene)}.pbrt")
+    with gzip.open(scene, "rb") as src, open(path, "wb") as dst:
+        dst.write(src.read())
+    return path
+
+
 def with_spp(scene, spp):
     """A copy of the scene beside it with its Sampler's pixelsamples set to spp; None when the
     scene names none (the renderers' default then applies to all)."""
@@ -157,6 +186,8 @@ def scenes(args):
         tool = os.path.join(ROOT, "bench", "tools", "make_large_scene.py")
         subprocess.run([sys.executable, tool, args.large], check=True)
     found.append(os.path.abspath(large))
+    if not args.no_interiors:
+        found += sorted(glob.glob(os.path.join(ROOT, "bench", "scenes", "*.pbrt.gz")))
     return found
 
 
@@ -166,6 +197,13 @@ def cell(result):
     return f"{result[0]:.2f}" if result[0] >= 1 else f"{result[0]:.3f}"
 
 
+def startup_cell(start, full):
+    """A one-pixel render's seconds and their share of the full render's."""
+    if start is None or full is None:
+        return "-"
+    return f"{cell(start)} ({100 * start[0] / full[0]:.0f}%)"
+
+
 def table(rows, names, args):
     head = ["scene"] + [f"{n} s" for n in names]
     if "pbrt-v4" in names and "acr" in names:
@@ -173,6 +211,8 @@ def table(rows, names, args):
     if "pbrt-v3" in names and "acr" in names:
         head.append("acr speed-up on pbrt-v3")
     head += [f"{n} peak MiB" for n in names]
+    starters = [n for n in names if n != "pbrt-v3"] if args.startup else []
+    head += [f"{n} start-up s (share)" for n in starters]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for scene, results in rows:
         work = results.get("acr, pbrt-v4's work")
@@ -189,11 +229,14 @@ def table(rows, names, args):
                 ok = acr is not None and theirs is not None
                 line.append(f"{theirs[0] / acr[0]:.2f}x" if ok else "-")
         line += ["failed" if results.get(n) is None else f"{results[n][1]:.0f}" for n in names]
+        line += [startup_cell(results.get(f"{n} start-up"), results.get(n)) for n in starters]
         lines.append("| " + " | ".join(line) + " |")
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip() or "unknown"
     cpu = platform.processor() or platform.machine()
     spp = f"{args.spp} spp" if args.spp else "its own spp"
+    if not args.no_interiors and not args.scene:
+        spp += " (the interiors: " + ", ".join(f"{n} {s}" for n, s in INTERIOR_SPP.items()) + ")"
     note = (f"Whole process, {args.threads} threads, median of {args.runs} run(s), "
             f"each scene at its own resolution and {spp}; acr commit {commit}, {os.cpu_count()} "
             f"cores ({cpu}), {time.strftime('%Y-%m-%d')}. Written by `bench/versus.py`.")
@@ -221,6 +264,8 @@ def main():
     p.add_argument("--spp", type=int)
     p.add_argument("--scene", action="append")
     p.add_argument("--large", default=os.path.join(ROOT, "bench", "cache", "large"))
+    p.add_argument("--no-interiors", action="store_true")
+    p.add_argument("--startup", action="store_true")
     p.add_argument("--out")
     args = p.parse_args()
     renderers = [("acr", args.acr)]
@@ -232,12 +277,15 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for original in scenes(args):
-            scene = with_spp(original, args.spp) if args.spp else None
+            text = decompressed(original)
+            spp = INTERIOR_SPP.get(scene_name(original), args.spp)
+            scene = with_spp(text or original, spp) if spp else None
             try:
-                rows.append(render_all(original, scene or original, renderers, args, tmp))
+                rows.append(render_all(original, scene or text or original, renderers, args, tmp))
             finally:
-                if scene:
-                    os.remove(scene)
+                for made in [scene, text]:
+                    if made:
+                        os.remove(made)
     text = table(rows, names, args)
     print(text)
     if args.out:
@@ -246,7 +294,7 @@ def main():
 
 def render_all(original, scene, renderers, args, tmp):
     """One table row: each renderer's (seconds, peak MiB) on `scene`, named after `original`."""
-    name = os.path.splitext(os.path.basename(original))[0]
+    name = scene_name(original)
     if os.sep + "shared" + os.sep in original:
         name = f"{name} (pbrt-v3's)"
     print(name, file=sys.stderr)
@@ -257,6 +305,9 @@ def render_all(original, scene, renderers, args, tmp):
         if label == "acr":
             cmd = [binary, "render", scene, "-o", image, "--threads", threads, "--quiet"]
             results[label] = measure(label, cmd, args.runs)
+            if args.startup:
+                one = cmd + ["--pixelbounds", ONE_PIXEL]
+                results[f"{label} start-up"] = measure(f"{label} one pixel", one, args.runs)
         elif label == "pbrt-v3":
             cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, scene]
             results[label] = measure(label, cmd, args.runs)
@@ -268,7 +319,10 @@ def render_all(original, scene, renderers, args, tmp):
             try:
                 cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, v4]
                 results[label] = measure(label, cmd, args.runs)
-                work = v4_work(original, v4)
+                if args.startup:
+                    one = cmd[:-1] + ["--pixelbounds", ONE_PIXEL, v4]
+                    results[f"{label} start-up"] = measure(f"{label} one pixel", one, args.runs)
+                work = v4_work(scene, v4)
                 acr = dict(renderers).get("acr")
                 if work and acr:
                     cmd = [acr, "render", scene, "-o", image, "--threads", threads, "--quiet"]
