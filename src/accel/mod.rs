@@ -364,10 +364,7 @@ impl Placement {
     fn at(&self, time: f32) -> (Mat4, Mat4) {
         match self {
             Placement::Fixed { to_world, to_local } => (*to_world, *to_local),
-            Placement::Moving(m) => {
-                let w = m.at(time);
-                (w, w.inverse())
-            }
+            Placement::Moving(m) => m.at_with_inverse(time),
         }
     }
 
