@@ -60,7 +60,7 @@ fn filled<const B: u64>(hash: u64, reversed: u64, scale: u64) -> f32 {
 /// independent per prefix, so one hash of the prefix draws them all at once (the cost is then
 /// log_B(spp) hashes, not 24). The result is a multiple of 1 / top_scale(B), a step wider than
 /// half an f32 ulp below 1 (top_scale < 2^25), so rounding to f32 never crosses an interval edge.
-/// The sampler calls [`owen_radical_inverse_fast`], which gives the same values.
+/// The sampler scrambles with [`Scrambling`] and [`Fill`], which give the same values.
 #[cfg(test)]
 pub(crate) fn owen_radical_inverse<const B: u64>(mut a: u64, hash: u64, exact: u64) -> f32 {
     let top = top_scale(B);
@@ -136,20 +136,48 @@ impl Fill {
     }
 }
 
-/// [`owen_radical_inverse`] of `a` for the `exact` of `fill`, bit for bit, without a
-/// division (the digits' remainders are by the constant B, the fill's by [`Fill`]).
-#[inline]
-pub(crate) fn owen_radical_inverse_fast<const B: u64>(mut a: u64, hash: u64, fill: &Fill) -> f32 {
-    let mut reversed: u64 = 0;
-    let mut scale: u64 = 1;
-    while scale < fill.scale {
-        let digit = a % B;
-        a /= B;
-        let (m, c) = digit_permutation::<B>(hash, reversed, scale);
-        reversed = reversed * B + (m * digit + c) % B;
-        scale *= B;
+/// One dim's scrambled radical inverse under way: the digits of the index not yet scrambled,
+/// the scrambled ones, and the scale of the next.
+#[derive(Clone, Copy, Debug)]
+struct Scrambling {
+    a: u64,
+    reversed: u64,
+    scale: u64,
+}
+
+impl Scrambling {
+    /// The scrambling of index `a`, no digit done.
+    fn new(a: u64) -> Self {
+        Self {
+            a,
+            reversed: 0,
+            scale: 1,
+        }
     }
-    fill.point(hash, reversed)
+
+    /// Scrambles the next digit in base `B`; false (and nothing done) once the digits down to
+    /// the fill's scale are. The digits' remainders are by the constant B.
+    #[inline(always)]
+    fn step<const B: u64>(&mut self, hash: u64, fill: &Fill) -> bool {
+        if self.scale >= fill.scale {
+            return false;
+        }
+        let digit = self.a % B;
+        self.a /= B;
+        let (m, c) = digit_permutation::<B>(hash, self.reversed, self.scale);
+        self.reversed = self.reversed * B + (m * digit + c) % B;
+        self.scale *= B;
+        true
+    }
+}
+
+/// [`owen_radical_inverse`] of `a` for the `exact` of `fill`, bit for bit, without a
+/// division ([`Scrambling`], [`Fill`]).
+#[cfg(test)]
+fn owen_radical_inverse_fast<const B: u64>(a: u64, hash: u64, fill: &Fill) -> f32 {
+    let mut s = Scrambling::new(a);
+    while s.step::<B>(hash, fill) {}
+    fill.point(hash, s.reversed)
 }
 
 /// Owen-scrambled Halton points per pixel.
@@ -203,22 +231,30 @@ impl PixelPattern for HaltonSampler {
         let h: [u64; 5] = std::array::from_fn(|d| mix64(key ^ (d as u64 + 1)));
         let e = &self.fills;
         for index in indices {
-            let a = u64::from(index);
-            let film = [
-                in_pixel(p[0], owen_radical_inverse_fast::<2>(a, h[0], &e[0])),
-                in_pixel(p[1], owen_radical_inverse_fast::<3>(a, h[1], &e[1])),
-            ];
-            // Inactive dims compute nothing: a pinhole still scene pays for x and y only.
-            let time = if dims.time {
-                owen_radical_inverse_fast::<5>(a, h[2], &e[2])
-            } else {
-                0.5
-            };
+            let mut s = [Scrambling::new(u64::from(index)); 5];
+            // Each dim's digits are a chain of hashes, each on the digits above it; the dims'
+            // chains are independent, so they advance a level at a time together, for the
+            // processor to overlap them. Inactive dims compute nothing: a pinhole still scene
+            // pays for x and y only.
+            loop {
+                let mut more = s[0].step::<2>(h[0], &e[0]);
+                more |= s[1].step::<3>(h[1], &e[1]);
+                if dims.time {
+                    more |= s[2].step::<5>(h[2], &e[2]);
+                }
+                if dims.lens {
+                    more |= s[3].step::<7>(h[3], &e[3]);
+                    more |= s[4].step::<11>(h[4], &e[4]);
+                }
+                if !more {
+                    break;
+                }
+            }
+            let point = |d: usize| e[d].point(h[d], s[d].reversed);
+            let film = [in_pixel(p[0], point(0)), in_pixel(p[1], point(1))];
+            let time = if dims.time { point(2) } else { 0.5 };
             let lens = if dims.lens {
-                [
-                    owen_radical_inverse_fast::<7>(a, h[3], &e[3]),
-                    owen_radical_inverse_fast::<11>(a, h[4], &e[4]),
-                ]
+                [point(3), point(4)]
             } else {
                 [0.5; 2]
             };
