@@ -292,7 +292,7 @@ impl Camera {
         }
         let time = self.time(s);
         let m = self.world_from_camera.at(time);
-        let (o, d) = self.camera_space_ray(s.film, s.lens);
+        let (o, d) = self.camera_space_ray(s.film, self.lens_point(s.lens));
         Ray::new(
             m.transform_point3(o),
             m.transform_vector3(d).normalize(),
@@ -322,9 +322,11 @@ impl Camera {
         let m = self.world_from_camera.at(time);
         let world =
             |(o, d): (Vec3, Vec3)| (m.transform_point3(o), m.transform_vector3(d).normalize());
-        let (o, d) = world(self.camera_space_ray(s.film, s.lens));
-        let (rx_o, rx_d) = world(self.camera_space_ray(s.film + Vec2::X, s.lens));
-        let (ry_o, ry_d) = world(self.camera_space_ray(s.film + Vec2::Y, s.lens));
+        // The three rays share the lens point: sampled once.
+        let lens = self.lens_point(s.lens);
+        let (o, d) = world(self.camera_space_ray(s.film, lens));
+        let (rx_o, rx_d) = world(self.camera_space_ray(s.film + Vec2::X, lens));
+        let (ry_o, ry_d) = world(self.camera_space_ray(s.film + Vec2::Y, lens));
         (
             Ray::new(o, d, time),
             RayDifferentials {
@@ -352,9 +354,16 @@ impl Camera {
         self.shutter_open + s.time * (self.shutter_close - self.shutter_open)
     }
 
-    /// The camera-space ray through raster point `film` and lens sample `lens` (direction
-    /// normalised).
-    fn camera_space_ray(&self, film: Vec2, lens: Vec2) -> (Vec3, Vec3) {
+    /// The point on the thin lens (camera space, z = 0) for lens sample `lens`; `None` for a
+    /// pinhole.
+    #[inline]
+    fn lens_point(&self, lens: Vec2) -> Option<Vec2> {
+        (self.lens_radius > 0.0).then(|| self.lens_radius * concentric_sample_disk(lens))
+    }
+
+    /// The camera-space ray through raster point `film` and the lens point `lens` (from
+    /// [`Camera::lens_point`]; direction normalised).
+    fn camera_space_ray(&self, film: Vec2, lens: Option<Vec2>) -> (Vec3, Vec3) {
         let p = self.raster_to_camera * Vec4::new(film.x, film.y, 0.0, 1.0);
         let p_camera = p.truncate() / p.w;
         let (mut o, mut d) = match self.projection {
@@ -373,8 +382,7 @@ impl Camera {
                 (Vec3::ZERO, d)
             }
         };
-        if self.lens_radius > 0.0 {
-            let lens = self.lens_radius * concentric_sample_disk(lens);
+        if let Some(lens) = lens {
             let ft = self.focal_distance / d.z;
             let focus = o + d * ft;
             // pbrt-v3's orthographic camera, too, puts the lens point at (lens.x, lens.y, 0),

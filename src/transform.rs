@@ -3,6 +3,8 @@
 //! scale; translation and scale are interpolated linearly and rotation by slerp.
 
 use glam::{DMat3, DMat4, DQuat, Mat4, Quat, Vec3};
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// One end of a motion, decomposed.
 #[derive(Clone, Copy, Debug)]
@@ -97,6 +99,41 @@ pub struct MotionTransform {
     end_time: f32,
     /// When it moves: its two ends decomposed, and the rotation's path between them.
     parts: Option<([Decomposed; 2], Slerp)>,
+    /// A number no other transform built in this process has: the key of its matrices in
+    /// [`MotionTransform::at_with_inverse`]'s per-thread cache.
+    id: u64,
+}
+
+/// The next [`MotionTransform::id`].
+static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+
+/// One cached evaluation: a transform's id, the time's bits, the matrix and its inverse.
+#[derive(Clone, Copy)]
+struct CachedAt {
+    id: u64,
+    time: u32,
+    at: Mat4,
+    inverse: Mat4,
+}
+
+/// Slots of the per-thread cache (direct-mapped by id: the moving instances of a scene have
+/// consecutive ids, so up to this many never evict one another).
+const CACHE_SLOTS: usize = 16;
+
+thread_local! {
+    /// The last evaluations on this thread. Every ray of a path carries the camera sample's
+    /// time, so a path's rays, its shadow rays and its hits' interactions all ask for the same
+    /// instance at the same time: one interpolation and one inverse serve them all.
+    static CACHE: RefCell<[CachedAt; CACHE_SLOTS]> = const {
+        RefCell::new(
+            [CachedAt {
+                id: 0,
+                time: 0,
+                at: Mat4::IDENTITY,
+                inverse: Mat4::IDENTITY,
+            }; CACHE_SLOTS],
+        )
+    };
 }
 
 impl MotionTransform {
@@ -118,6 +155,7 @@ impl MotionTransform {
             start_time: desc.start_time as f32,
             end_time: desc.end_time as f32,
             parts,
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
         }
     }
 
@@ -147,6 +185,27 @@ impl MotionTransform {
             a.scale.w_axis.lerp(b.scale.w_axis, dt),
         );
         Mat4::from_translation(trans) * Mat4::from_quat(rot) * scale
+    }
+
+    /// The transform at `time` and its inverse, as `at(time)` and `at(time).inverse()` give
+    /// them (bit for bit: the same computation, remembered per thread for the last time asked).
+    pub fn at_with_inverse(&self, time: f32) -> (Mat4, Mat4) {
+        let slot = (self.id % CACHE_SLOTS as u64) as usize;
+        let bits = time.to_bits();
+        CACHE.with(|cache| {
+            let mut cache = cache.borrow_mut();
+            let c = &mut cache[slot];
+            if c.id != self.id || c.time != bits {
+                let at = self.at(time);
+                *c = CachedAt {
+                    id: self.id,
+                    time: bits,
+                    at,
+                    inverse: at.inverse(),
+                };
+            }
+            (c.at, c.inverse)
+        })
     }
 
     /// A box containing `bounds` (min, max) transformed at every time of the shutter.
@@ -228,6 +287,26 @@ mod tests {
         assert!(m.at(0.0).abs_diff_eq(a.as_mat4(), 1e-6));
         assert!(m.at(1.0).abs_diff_eq(b.as_mat4(), 1e-5));
         assert!(!motion(a, a).is_moving());
+    }
+
+    #[test]
+    fn cached_evaluation_is_the_computed_one() {
+        // Seventeen transforms: the first and the last share a cache slot.
+        let ms: Vec<MotionTransform> = (0..17)
+            .map(|i| {
+                motion(
+                    DMat4::from_translation(DVec3::new(i as f64, 0.0, 1.0)),
+                    DMat4::from_rotation_y(0.1 * i as f64 + 0.3),
+                )
+            })
+            .collect();
+        for t in [0.25f32, 0.5, 0.25, 1.5, 0.5] {
+            for m in ms.iter().chain(ms.iter().rev()) {
+                let (at, inverse) = m.at_with_inverse(t);
+                assert_eq!(at.to_cols_array(), m.at(t).to_cols_array());
+                assert_eq!(inverse.to_cols_array(), m.at(t).inverse().to_cols_array());
+            }
+        }
     }
 
     #[test]

@@ -284,6 +284,31 @@ impl Geometry {
         best
     }
 
+    /// [`Geometry::intersect`] for an instance's geometry, whose box the top-level BVH has
+    /// already tested in the world: one primitive (a moving shape) is tested straight away,
+    /// without its own BVH's setup and box.
+    fn intersect_instanced(&self, ray: &Ray, t_max: f32, instance: u32) -> Option<Hit> {
+        if self.prims.len() != 1 {
+            return self.intersect(ray, t_max, Some(instance));
+        }
+        let (t, local) = self.intersect_prim(0, ray, &TriangleRay::new(ray), t_max)?;
+        Some(Hit {
+            t,
+            prim: self.prims[0],
+            instance: Some(instance),
+            local,
+        })
+    }
+
+    /// [`Geometry::occluded`] for an instance's geometry, as [`Geometry::intersect_instanced`].
+    fn occluded_instanced(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.prims.len() != 1 {
+            return self.occluded(ray, t_max);
+        }
+        self.intersect_prim(0, ray, &TriangleRay::new(ray), t_max)
+            .is_some()
+    }
+
     /// Whether anything lies on the ray closer than `t_max` (stops at the first hit).
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         let Some(bvh) = &self.bvh else {
@@ -364,10 +389,7 @@ impl Placement {
     fn at(&self, time: f32) -> (Mat4, Mat4) {
         match self {
             Placement::Fixed { to_world, to_local } => (*to_world, *to_local),
-            Placement::Moving(m) => {
-                let w = m.at(time);
-                (w, w.inverse())
-            }
+            Placement::Moving(m) => m.at_with_inverse(time),
         }
     }
 
@@ -499,7 +521,7 @@ impl Accel {
             let inst = &self.instances[index as usize];
             let (_, to_local) = inst.placement.at(ray.time);
             let local = local_ray(ray, &to_local);
-            match self.objects[inst.object as usize].intersect(&local, r.tmax, Some(index)) {
+            match self.objects[inst.object as usize].intersect_instanced(&local, r.tmax, index) {
                 Some(h) => {
                     best = Some(h);
                     h.t
@@ -522,7 +544,7 @@ impl Accel {
             let inst = &self.instances[self.tlas_order[id] as usize];
             let (_, to_local) = inst.placement.at(ray.time);
             let local = local_ray(ray, &to_local);
-            if self.objects[inst.object as usize].occluded(&local, t_max) {
+            if self.objects[inst.object as usize].occluded_instanced(&local, t_max) {
                 0.0
             } else {
                 f32::INFINITY

@@ -32,6 +32,26 @@ pub(crate) fn scale_for(b: u64, n: u64) -> u64 {
     s
 }
 
+/// The random affine permutation `d -> (m d + c) mod B` of the digit at `scale` under the
+/// scrambled digits `reversed` above it (nested, as Owen's scrambling).
+#[inline]
+fn digit_permutation<const B: u64>(hash: u64, reversed: u64, scale: u64) -> (u64, u64) {
+    let h = mix64(hash ^ reversed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ scale);
+    // B is prime, so any multiplier in 1..B is a bijection; the shift makes d uniform.
+    (1 + h % (B - 1), (h >> 32) % B)
+}
+
+/// The point of the scrambled digits `reversed` (down to `scale`), their prefix's random fill
+/// below added. [`Fill::point`] gives the same values faster.
+#[cfg(test)]
+fn filled<const B: u64>(hash: u64, reversed: u64, scale: u64) -> f32 {
+    let top = top_scale(B);
+    let rest = top / scale;
+    let fill = mix64(hash ^ reversed.wrapping_mul(0xd6e8_feb8_6659_fd93) ^ scale) % rest;
+    let r = reversed * rest + fill;
+    ((r as f64 / top as f64) as f32).min(ONE_MINUS_EPSILON)
+}
+
 /// Owen-scrambled radical inverse of `a` in base `B`, digits scrambled one by one down to
 /// `exact` (a power of B above every index used, from [`scale_for`]). Each digit goes through
 /// a random affine permutation `d -> (m d + c) mod B` chosen by a hash of `hash` and the digits
@@ -40,7 +60,8 @@ pub(crate) fn scale_for(b: u64, n: u64) -> u64 {
 /// independent per prefix, so one hash of the prefix draws them all at once (the cost is then
 /// log_B(spp) hashes, not 24). The result is a multiple of 1 / top_scale(B), a step wider than
 /// half an f32 ulp below 1 (top_scale < 2^25), so rounding to f32 never crosses an interval edge.
-#[inline]
+/// The sampler scrambles with [`Scrambling`] and [`Fill`], which give the same values.
+#[cfg(test)]
 pub(crate) fn owen_radical_inverse<const B: u64>(mut a: u64, hash: u64, exact: u64) -> f32 {
     let top = top_scale(B);
     let mut reversed: u64 = 0;
@@ -48,17 +69,115 @@ pub(crate) fn owen_radical_inverse<const B: u64>(mut a: u64, hash: u64, exact: u
     while scale < exact && scale < top {
         let digit = a % B;
         a /= B;
-        let h = mix64(hash ^ reversed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ scale);
-        // B is prime, so any multiplier in 1..B is a bijection; the shift makes d uniform.
-        let m = 1 + h % (B - 1);
-        let c = (h >> 32) % B;
+        let (m, c) = digit_permutation::<B>(hash, reversed, scale);
         reversed = reversed * B + (m * digit + c) % B;
         scale *= B;
     }
-    let rest = top / scale;
-    let fill = mix64(hash ^ reversed.wrapping_mul(0xd6e8_feb8_6659_fd93) ^ scale) % rest;
-    let r = reversed * rest + fill;
-    ((r as f64 / top as f64) as f32).min(ONE_MINUS_EPSILON)
+    filled::<B>(hash, reversed, scale)
+}
+
+/// The fill below the digits scrambled one by one, for base `B` down to a given `exact`: its
+/// constants are computed once, so that a point costs no division (a hash's remainder by
+/// Lemire, Kaser and Kurz's direct computation, the scaling by a reciprocal), with the values
+/// of the divisions bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fill {
+    /// The scale the one-by-one digits end at (the first power of B at least `exact`, at
+    /// most top_scale(B)).
+    scale: u64,
+    /// top_scale(B) / scale: the fill's range.
+    rest: u64,
+    /// ceil(2^128 / rest) (0 for rest = 1): `x % rest` is the high part of
+    /// `(magic * x mod 2^128) * rest`.
+    magic: u128,
+    /// 1 / top_scale(B).
+    inv_top: f64,
+}
+
+impl Fill {
+    /// The fill of base `B` below `exact`.
+    pub(crate) fn new<const B: u64>(exact: u64) -> Self {
+        let top = top_scale(B);
+        let mut scale = 1;
+        while scale < exact && scale < top {
+            scale *= B;
+        }
+        let rest = top / scale;
+        Self {
+            scale,
+            rest,
+            magic: (u128::MAX / u128::from(rest)).wrapping_add(1),
+            inv_top: 1.0 / top as f64,
+        }
+    }
+
+    /// `x % self.rest`, by multiplication (exact for every 64-bit `x`: the 128-bit magic
+    /// carries twice the bits of the operands).
+    #[inline]
+    fn rem(&self, x: u64) -> u64 {
+        let low = self.magic.wrapping_mul(u128::from(x));
+        let rest = u128::from(self.rest);
+        let lo = u128::from(low as u64) * rest;
+        let hi = (low >> 64) * rest;
+        ((hi + (lo >> 64)) >> 64) as u64
+    }
+
+    /// The point of the scrambled digits `reversed` with the fill below them: `filled`'s
+    /// value. The product by 1 / top in place of the division rounds to the same f32: top is
+    /// odd (or a power of two, where both are exact), so r / top lies at least 2^-50 (relative)
+    /// from every f32 rounding boundary, and the two f64 values are within 2^-52 of it.
+    #[inline]
+    fn point(&self, hash: u64, reversed: u64) -> f32 {
+        let fill = self.rem(mix64(
+            hash ^ reversed.wrapping_mul(0xd6e8_feb8_6659_fd93) ^ self.scale,
+        ));
+        let r = reversed * self.rest + fill;
+        ((r as f64 * self.inv_top) as f32).min(ONE_MINUS_EPSILON)
+    }
+}
+
+/// One dim's scrambled radical inverse under way: the digits of the index not yet scrambled,
+/// the scrambled ones, and the scale of the next.
+#[derive(Clone, Copy, Debug)]
+struct Scrambling {
+    a: u64,
+    reversed: u64,
+    scale: u64,
+}
+
+impl Scrambling {
+    /// The scrambling of index `a`, no digit done.
+    fn new(a: u64) -> Self {
+        Self {
+            a,
+            reversed: 0,
+            scale: 1,
+        }
+    }
+
+    /// Scrambles the next digit in base `B`; false (and nothing done) once the digits down to
+    /// the fill's scale are. The digits' remainders are by the constant B.
+    #[inline(always)]
+    fn step<const B: u64>(&mut self, hash: u64, fill: &Fill) -> bool {
+        if self.scale >= fill.scale {
+            return false;
+        }
+        let digit = self.a % B;
+        self.a /= B;
+        let (m, c) = digit_permutation::<B>(hash, self.reversed, self.scale);
+        self.reversed = self.reversed * B + (m * digit + c) % B;
+        self.scale *= B;
+        true
+    }
+}
+
+/// [`owen_radical_inverse`] of `a` for the `exact` of `fill`, bit for bit, without a
+/// division ([`Scrambling`], [`Fill`]).
+#[cfg(test)]
+fn owen_radical_inverse_fast<const B: u64>(a: u64, hash: u64, fill: &Fill) -> f32 {
+    let mut s = Scrambling::new(a);
+    while s.step::<B>(hash, fill) {}
+    fill.point(hash, s.reversed)
 }
 
 /// Owen-scrambled Halton points per pixel.
@@ -66,8 +185,9 @@ pub(crate) fn owen_radical_inverse<const B: u64>(mut a: u64, hash: u64, exact: u
 pub struct HaltonSampler {
     cursor: PixelCursor,
     seed: u64,
-    /// Per base (2, 3, 5, 7, 11): the scale down to which digits are scrambled one by one.
-    exact: [u64; 5],
+    /// Per base (2, 3, 5, 7, 11): the fill below the scale down to which digits are
+    /// scrambled one by one.
+    fills: [Fill; 5],
 }
 
 impl HaltonSampler {
@@ -76,7 +196,16 @@ impl HaltonSampler {
         Self {
             cursor: PixelCursor::new(space, spp),
             seed,
-            exact: [2, 3, 5, 7, 11].map(|b| scale_for(b, u64::from(spp))),
+            fills: {
+                let n = u64::from(spp);
+                [
+                    Fill::new::<2>(scale_for(2, n)),
+                    Fill::new::<3>(scale_for(3, n)),
+                    Fill::new::<5>(scale_for(5, n)),
+                    Fill::new::<7>(scale_for(7, n)),
+                    Fill::new::<11>(scale_for(11, n)),
+                ]
+            },
         }
     }
 }
@@ -100,24 +229,32 @@ impl PixelPattern for HaltonSampler {
         let key = pixel_key(p, self.seed, SALT);
         // One independent scramble per dim.
         let h: [u64; 5] = std::array::from_fn(|d| mix64(key ^ (d as u64 + 1)));
-        let e = self.exact;
+        let e = &self.fills;
         for index in indices {
-            let a = u64::from(index);
-            let film = [
-                in_pixel(p[0], owen_radical_inverse::<2>(a, h[0], e[0])),
-                in_pixel(p[1], owen_radical_inverse::<3>(a, h[1], e[1])),
-            ];
-            // Inactive dims compute nothing: a pinhole still scene pays for x and y only.
-            let time = if dims.time {
-                owen_radical_inverse::<5>(a, h[2], e[2])
-            } else {
-                0.5
-            };
+            let mut s = [Scrambling::new(u64::from(index)); 5];
+            // Each dim's digits are a chain of hashes, each on the digits above it; the dims'
+            // chains are independent, so they advance a level at a time together, for the
+            // processor to overlap them. Inactive dims compute nothing: a pinhole still scene
+            // pays for x and y only.
+            loop {
+                let mut more = s[0].step::<2>(h[0], &e[0]);
+                more |= s[1].step::<3>(h[1], &e[1]);
+                if dims.time {
+                    more |= s[2].step::<5>(h[2], &e[2]);
+                }
+                if dims.lens {
+                    more |= s[3].step::<7>(h[3], &e[3]);
+                    more |= s[4].step::<11>(h[4], &e[4]);
+                }
+                if !more {
+                    break;
+                }
+            }
+            let point = |d: usize| e[d].point(h[d], s[d].reversed);
+            let film = [in_pixel(p[0], point(0)), in_pixel(p[1], point(1))];
+            let time = if dims.time { point(2) } else { 0.5 };
             let lens = if dims.lens {
-                [
-                    owen_radical_inverse::<7>(a, h[3], e[3]),
-                    owen_radical_inverse::<11>(a, h[4], e[4]),
-                ]
+                [point(3), point(4)]
             } else {
                 [0.5; 2]
             };
@@ -217,6 +354,64 @@ mod tests {
             .filter(|&h| (owen_radical_inverse::<3>(4, h, 9) * 9.0).fract() != 0.0)
             .count();
         assert!(off_grid > 60, "{off_grid}");
+    }
+
+    #[test]
+    fn fast_radical_inverse_is_the_divisions_one() {
+        fn check<const B: u64>() {
+            for exact in [
+                1,
+                scale_for(B, 16),
+                scale_for(B, 100),
+                scale_for(B, 1 << 30),
+            ] {
+                let fill = Fill::new::<B>(exact);
+                for a in (0..2000).chain([1 << 20, (1 << 32) - 1, u64::MAX / 3]) {
+                    for hash in [0u64, 0xdead_beef, mix64(a)] {
+                        let fast = owen_radical_inverse_fast::<B>(a, hash, &fill);
+                        let slow = owen_radical_inverse::<B>(a, hash, exact);
+                        assert_eq!(fast.to_bits(), slow.to_bits(), "b {B} a {a} e {exact}");
+                    }
+                }
+            }
+        }
+        check::<2>();
+        check::<3>();
+        check::<5>();
+        check::<7>();
+        check::<11>();
+    }
+
+    #[test]
+    fn fill_divides_without_dividing() {
+        fn check<const B: u64>() {
+            let top = top_scale(B);
+            let inv = 1.0 / top as f64;
+            // Every point the fill can give: the product rounds to the quotient's f32.
+            for r in 0..top {
+                let (q, p) = (r as f64 / top as f64, r as f64 * inv);
+                assert_eq!((q as f32).to_bits(), (p as f32).to_bits(), "b {B} r {r}");
+            }
+            // The remainder of every rest (each power of B) for hashes all over 64 bits.
+            let mut exact = 1;
+            loop {
+                let f = Fill::new::<B>(exact);
+                for i in 0..20_000u64 {
+                    for x in [mix64(i), i, u64::MAX - i, (f.rest * i).wrapping_sub(1)] {
+                        assert_eq!(f.rem(x), x % f.rest, "b {B} rest {} x {x}", f.rest);
+                    }
+                }
+                if f.rest == 1 {
+                    break;
+                }
+                exact *= B;
+            }
+        }
+        check::<2>();
+        check::<3>();
+        check::<5>();
+        check::<7>();
+        check::<11>();
     }
 
     #[test]
