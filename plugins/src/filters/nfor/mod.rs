@@ -14,7 +14,7 @@ mod planes;
 mod regression;
 mod selection;
 
-use super::{BoxFilter, Filter, FilterBuild, FilterKernel, SamplerOutput};
+use super::{BandPlan, BoxFilter, Filter, FilterBuild, FilterKernel, SamplerOutput};
 use crate::film::{Film, PixelBuffers, Spectrum};
 use crate::first_hit::FEATURES;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
@@ -60,7 +60,7 @@ const SECOND_PASS_K: f32 = 1.0;
 const PREFILTER_K: f32 = 0.5;
 
 /// The NFOR reconstruction.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct NforFilter {
     radius: usize,
     patch: usize,
@@ -135,6 +135,15 @@ impl NforFilter {
         }
     }
 
+    /// The bands (with `second`, for the second pass's reach too): a halo that covers
+    /// [`NforFilter::reach`], band and halo on the tile grid.
+    fn plan(&self, second: bool) -> BandPlan {
+        BandPlan {
+            rows: self.band.next_multiple_of(TILE),
+            halo: self.reach(second).next_multiple_of(TILE),
+        }
+    }
+
     /// The filtered image and its estimated per-pixel MSE (bandwidths `ks`; with `second`,
     /// the second pass too), band by band: `take` gets each band's image and MSE (over the
     /// band's rows with their halo) and the band's own rows within them, top band first.
@@ -149,19 +158,11 @@ impl NforFilter {
     ) {
         let h = b.size().1 as usize;
         let depth = depth_scale(b);
-        let band = match self.band {
-            0 => h.max(1),
-            n => n.next_multiple_of(TILE),
-        };
-        let halo = self.reach(second).next_multiple_of(TILE);
-        let mut y = 0;
-        while y < h {
-            // A remainder within the halo joins its band: those rows are read anyway.
-            let end = if y + band + halo >= h { h } else { y + band };
-            let rows = y.saturating_sub(halo)..(end + halo).min(h);
+        let plan = self.plan(second);
+        for band in plan.layout(h) {
+            let rows = plan.read(&band, h);
             let (image, mse) = self.denoise(b, rows.clone(), depth, ks, second);
-            take(&image, &mse, y - rows.start..end - rows.start);
-            y = end;
+            take(&image, &mse, band.start - rows.start..band.end - rows.start);
         }
     }
 
@@ -332,6 +333,35 @@ impl Filter for NforFilter {
             );
         });
         out
+    }
+
+    fn bands(&self) -> Option<BandPlan> {
+        (self.band > 0).then(|| self.plan(self.second_pass))
+    }
+
+    fn reconstruct_rows(&self, film: &Film, rows: Range<usize>) -> Vec<Spectrum> {
+        let Some(b) = film.pixel_buffers() else {
+            let w = film.settings().size().0 as usize;
+            let stats = film.pixel_stats();
+            return stats[rows.start * w..rows.end * w]
+                .iter()
+                .map(|s| s.mean())
+                .collect();
+        };
+        let h = b.size().1 as usize;
+        let read = self.plan(self.second_pass).read(&rows, h);
+        let (image, _) = self.denoise(
+            b,
+            read.clone(),
+            depth_scale(b),
+            &BANDWIDTHS,
+            self.second_pass,
+        );
+        let span = (rows.start - read.start) * image.w * 3..(rows.end - read.start) * image.w * 3;
+        image.data[span]
+            .chunks(3)
+            .map(|c| Spectrum::new(c[0], c[1], c[2]).max(Spectrum::ZERO))
+            .collect()
     }
 
     fn estimated_error(&self, film: &Film) -> Option<Vec<f32>> {
