@@ -142,6 +142,28 @@ impl PixelBuffers {
         }
     }
 
+    /// Buffers for a render by bands ([`PixelBuffers::hold_rows`]): no row held yet, room for
+    /// `window` rows.
+    pub fn by_rows_of(
+        width: u32,
+        height: u32,
+        origin: [u32; 2],
+        keep_stats: bool,
+        window: usize,
+    ) -> Self {
+        let mut b = Self {
+            width,
+            height,
+            origin,
+            halves: [Vec::new(), Vec::new()],
+            first_row: 0,
+            released: None,
+            depth_scale: None,
+        };
+        b.hold_rows(keep_stats, window);
+        b
+    }
+
     /// The crop's size in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
@@ -217,8 +239,27 @@ impl PixelBuffers {
         }
         for h in &mut self.halves {
             h.drain(..held);
+            if h.is_empty() {
+                // The last rows: their room goes too.
+                *h = Vec::new();
+            }
         }
         self.first_row = row;
+    }
+
+    /// In a render by bands, makes the halves hold every row above crop row `row`, those
+    /// not sampled empty (a halted render's rows below the last it reached).
+    pub fn hold_through(&mut self, row: usize) {
+        if self.released.is_none() {
+            return;
+        }
+        let n =
+            (row.min(self.height as usize).saturating_sub(self.first_row)) * self.width as usize;
+        for h in &mut self.halves {
+            if h.len() < n {
+                h.resize(n, HalfPixel::default());
+            }
+        }
     }
 
     /// The depth scale the render set ([`PixelBuffers::set_depth_scale`]).

@@ -152,6 +152,30 @@ impl Film {
         }
     }
 
+    /// [`Film::keep_pixel_buffers`] for a render by bands ([`Film::hold_rows`]), the whole
+    /// image's halves never made.
+    pub fn keep_pixel_buffers_by_rows(&mut self, keep_stats: bool, window: usize) {
+        self.sums = Vec::new();
+        self.stats = Vec::new();
+        let [cx0, _, cy0, _] = self.settings.crop;
+        let (w, h) = self.settings.size();
+        self.buffers = Some(Box::new(PixelBuffers::by_rows_of(
+            w,
+            h,
+            [cx0, cy0],
+            keep_stats,
+            window,
+        )));
+    }
+
+    /// In a render by bands, makes the half buffers hold every row above crop row `row`
+    /// ([`PixelBuffers::hold_through`]).
+    pub fn hold_through(&mut self, row: usize) {
+        if let Some(b) = self.buffers.as_mut() {
+            b.hold_through(row);
+        }
+    }
+
     /// In a render by bands, frees the half buffers' rows above crop row `row`.
     pub fn release_rows(&mut self, row: usize) {
         if let Some(b) = self.buffers.as_mut() {
