@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
 pub use acr_plugins::sampler::MAX_SPP;
-pub use bands::{render_in_bands, Bands};
+pub use bands::{render_in_bands, Banded, Bands};
 pub use stop::{Checkpoint, ErrorEstimate, Halt, RenderCounts, Stop};
 
 pub mod bands;
@@ -378,7 +378,7 @@ fn render_loop(
     }
     if pending {
         traced.hand_over(sampler, film, &mut in_sampler);
-        if let Some(b) = bands.as_deref_mut() {
+        if let Some(b) = bands {
             b.rows_in(film, traced.rows_given);
         }
     }

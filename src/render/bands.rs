@@ -40,14 +40,27 @@ pub struct Bands<'f> {
     image: Vec<Spectrum>,
     /// Seconds spent filtering.
     seconds: f64,
+    /// Bands filtered.
+    made: u64,
+}
+
+/// What a render by bands made.
+#[derive(Clone, Debug, Default)]
+pub struct Banded {
+    /// The image, row-major over the crop (before the film's unfiltered splats and scale).
+    pub image: Vec<Spectrum>,
+    /// Seconds spent filtering.
+    pub seconds: f64,
+    /// Bands filtered.
+    pub bands: u64,
 }
 
 impl<'f> Bands<'f> {
     /// The rows a film's half buffers need room for in a render by bands with `filter`
-    /// ([`Film::keep_pixel_buffers_by_rows`]): a band, its halo above and below, and a chunk
-    /// under way. None for a filter that needs the whole film.
-    pub fn window(filter: &dyn Filter) -> Option<usize> {
-        let plan = filter.bands()?;
+    /// ([`Film::keep_pixel_buffers_by_rows`]) for an image of `height` rows: a band, its halo
+    /// above and below, and a chunk under way. None for a filter that needs the whole film.
+    pub fn window(filter: &dyn Filter, height: u32) -> Option<usize> {
+        let plan = filter.bands(height as usize)?;
         Some(plan.rows.max(1) + 2 * plan.halo + CHUNK_ROWS as usize)
     }
 
@@ -61,12 +74,12 @@ impl<'f> Bands<'f> {
         sampler: &mut dyn Sampler,
         film: &Film,
     ) -> Option<Self> {
-        let plan = filter.bands()?;
+        let (w, h) = film.settings().size();
+        let plan = filter.bands(h as usize)?;
         let by_rows = film.pixel_buffers().is_some_and(|b| b.by_rows());
         if !by_rows || sampler.streams() != 1 || !sampler.walk_by_rows(CHUNK_ROWS) {
             return None;
         }
-        let (w, h) = film.settings().size();
         let space = sample_space(scene, filter.kernel().radius());
         let rows_above = scene.film.crop[2].saturating_sub(space.y0) as usize;
         Some(Self {
@@ -78,6 +91,7 @@ impl<'f> Bands<'f> {
             rows_in: 0,
             image: Vec::with_capacity(w as usize * h as usize),
             seconds: 0.0,
+            made: 0,
         })
     }
 
@@ -104,17 +118,21 @@ impl<'f> Bands<'f> {
             .extend(self.filter.reconstruct_rows(film, band.clone()));
         film.release_rows(band.end.saturating_sub(self.plan.halo));
         self.seconds += start.elapsed().as_secs_f64();
+        self.made += 1;
     }
 
     /// Filters the bands left (after a halt, from the samples they have: rows never sampled
-    /// come out black) and frees the half buffers: the image, row-major over the crop, and
-    /// the seconds spent filtering in all.
-    pub fn finish(mut self, film: &mut Film) -> (Vec<Spectrum>, f64) {
+    /// come out black) and frees the half buffers.
+    pub fn finish(mut self, film: &mut Film) -> Banded {
         while let Some(band) = self.left.pop_front() {
             self.make(film, band);
         }
         film.release_rows(self.height);
-        (self.image, self.seconds)
+        Banded {
+            image: self.image,
+            seconds: self.seconds,
+            bands: self.made,
+        }
     }
 }
 

@@ -79,10 +79,12 @@ pub trait Filter: Send + Sync {
         None
     }
 
-    /// How the filter makes the image band by band in a render by bands (docs/reconstruction.md,
-    /// "Rendering by bands"): each band of rows from those rows and its halo alone, so that
-    /// the film need hold no more; None for a filter that needs the whole film at once.
-    fn bands(&self) -> Option<BandPlan> {
+    /// How the filter makes an image of `height` rows band by band in a render by bands
+    /// (docs/reconstruction.md, "Rendering by bands"): each band of rows from those rows and
+    /// its halo alone, so that the film need hold no more; None for a filter that needs the
+    /// whole film at once.
+    fn bands(&self, height: usize) -> Option<BandPlan> {
+        let _ = height;
         None
     }
 

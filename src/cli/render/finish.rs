@@ -67,7 +67,7 @@ pub(super) fn stats(
     let counts = &rendered.counts;
     let plugins = &job.plugins;
     // A render by bands filtered as it went: that time is the reconstruction's.
-    let banded_s = rendered.banded.as_ref().map_or(0.0, |(_, s)| *s);
+    let banded_s = rendered.banded.as_ref().map_or(0.0, |b| b.seconds);
     let render_s = clock.render_seconds() - banded_s;
     let report = plugins.sampler.report();
     Stats {
@@ -96,6 +96,7 @@ pub(super) fn stats(
         cells: report.cells,
         rounds: report.rounds,
         fitted_by_degree: plugins.filter.report().fitted_by_degree,
+        bands: rendered.banded.as_ref().map(|b| b.bands),
         dropped_samples: counts.dropped,
         seconds: Seconds {
             parse: (clock.parsed - clock.start).as_secs_f64(),

@@ -79,9 +79,9 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
 
     let image = match rendered.banded.as_mut() {
         // A render by bands made its image as it went.
-        Some((rows, _)) => job
+        Some(b) => job
             .plugins
-            .finish_image(&rendered.film, std::mem::take(rows)),
+            .finish_image(&rendered.film, std::mem::take(&mut b.image)),
         None => job.plugins.image(&rendered.film),
     };
     clock.reconstructed = Instant::now();

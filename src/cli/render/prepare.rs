@@ -122,7 +122,7 @@ impl Job {
 /// threshold (which stop the image as a whole), no mergeable sums, partial images, viewer or
 /// sampler-cost replay.
 fn by_bands(args: &RenderArgs, plugins: &mut Plugins, height: u32) -> bool {
-    let bands = plugins.filter.bands();
+    let bands = plugins.filter.bands(height as usize);
     let several = bands.is_some_and(|b| b.layout(height as usize).len() > 1);
     let camera_pixels = !matches!(
         plugins.integrator,

@@ -10,7 +10,7 @@ use crate::cli::output::Output;
 use crate::cli::replay::Recording;
 use crate::first_hit::FeatureImage;
 use crate::integrator::Integrator;
-use crate::render::{render_in_bands, render_with_features, Bands, Checkpoint, Halt};
+use crate::render::{render_in_bands, render_with_features, Banded, Bands, Checkpoint, Halt};
 use crate::render::{RenderCounts, Stop};
 use acr_plugins::{Film, SamplePoint, Sampler};
 use std::io::IsTerminal;
@@ -32,8 +32,8 @@ pub(super) struct Rendered {
     pub(super) batches: Option<Vec<Vec<SamplePoint>>>,
     /// Samples per pixel planned.
     pub(super) spp: u32,
-    /// A render by bands: the image its filter made band by band, and the seconds that took.
-    pub(super) banded: Option<(Vec<acr_plugins::film::Spectrum>, f64)>,
+    /// A render by bands: the image its filter made band by band.
+    pub(super) banded: Option<Banded>,
 }
 
 impl Rendered {
@@ -57,7 +57,7 @@ pub(super) fn render_scene(
         .any(|a| matches!(a.name.as_str(), "spp" | "variance"));
     let window = job
         .by_bands
-        .then(|| Bands::window(job.plugins.filter.as_ref()))
+        .then(|| Bands::window(job.plugins.filter.as_ref(), job.size().1))
         .flatten();
     let mut film = job
         .plugins

@@ -228,7 +228,7 @@ fn a_film_that_holds_a_window_of_rows_gives_the_whole_images_bytes() {
         let mut whole = film(w, h, 4, striped(w));
         whole.set_depth_scale(0.25);
         let expected = reconstruct(&filter.clone().with_band(0), &whole);
-        let plan = filter.bands().expect("bands");
+        let plan = filter.bands(h as usize).expect("bands");
         let mut film = Film::new(
             FilmSettings::with_resolution(w, h),
             &BoxFilter::new(0.5, 0.5),
