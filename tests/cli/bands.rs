@@ -73,3 +73,60 @@ fn a_render_by_bands_is_the_whole_images_render_byte_for_byte() {
     assert_eq!(bits(&spp), bits(&read("spp.exr")));
     assert_eq!(bits(&var), bits(&read("var.exr")));
 }
+
+/// A signal stops a render by bands at the end of the pass under way in its band: the image
+/// written holds the rows reached (filtered) and black below, is not a mergeable file, and
+/// the message says to render again.
+// Signals, and `libc::kill` to send one, are Unix only.
+#[cfg(unix)]
+#[test]
+fn a_signal_writes_the_rows_a_render_by_bands_reached() {
+    let dir = TempDir::new("bands-signal");
+    let scene = dir.write("c.pbrt", &example_scene("cornell-box.pbrt", 400, 200));
+    let (out, stats) = (dir.join("c.exr"), dir.join("c.json"));
+    let child = acr_command([
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+        "--sampler",
+        "stratified",
+        "--filter",
+        "nfor",
+        "--set",
+        "filter.band=32",
+        "--spp",
+        "65536",
+        "--threads",
+        "1",
+        "--quiet",
+    ])
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    // SAFETY: kill(2) on our own child's pid, with a valid signal number.
+    let rc = unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    assert_eq!(rc, 0);
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{err}");
+    assert!(err.contains("interrupted by a signal"), "{err}");
+    assert!(err.contains("render again to finish it"), "{err}");
+    let stats = read_stats(&stats);
+    assert_eq!(stats["halted_by"], "signal", "{stats}");
+    assert!(stats["bands"].as_u64().unwrap() > 1, "{stats}");
+    let img = read_image(&out, false).unwrap();
+    assert_eq!((img.width, img.height), (400, 200));
+    let row_mean = |y: usize| {
+        img.pixels[y * 400..(y + 1) * 400]
+            .iter()
+            .map(|c| f64::from(c.x + c.y + c.z))
+            .sum::<f64>()
+    };
+    // The first chunk's rows were sampled, the last rows never.
+    assert!(row_mean(5) > 0.0 && row_mean(5).is_finite());
+    assert_eq!(row_mean(199), 0.0);
+}
