@@ -48,11 +48,15 @@ fn a_render_by_bands_is_the_whole_images_render_byte_for_byte() {
     assert!(stats["bands"].is_null(), "{stats}");
     assert_eq!(bits(&banded), bits(&at_end));
     // One thread and two.
+    // The spp AOV of a render by bands reads each released pixel's count alone.
+    let spp_one = format!("spp={}", dir.join("spp1.exr").display());
     let mut one = band.to_vec();
-    one.extend(["--threads", "1"]);
+    one.extend(["--threads", "1", "--aov", &spp_one]);
     let mut two = band.to_vec();
     two.extend(["--threads", "2"]);
     assert_eq!(bits(&render("one", &one).0), bits(&render("two", &two).0));
+    let counts = read_image(&dir.join("spp1.exr"), false).unwrap().pixels;
+    assert!(counts.len() == 24 * 200 && counts.iter().all(|c| c.x == 4.0));
     // A crop, with the spp and variance AOVs (each released pixel's statistics kept).
     let aovs = format!(
         "spp={},variance={}",

@@ -144,7 +144,7 @@ impl Film {
 
     /// A render by bands (docs/reconstruction.md, "Rendering by bands"): the half buffers hold
     /// the rows under way only, room made for `window` rows, and of the rows released each
-    /// pixel's statistics when `keep_stats` (the spp and variance AOVs read them), else its
+    /// pixel's statistics when `keep_stats` (the variance AOV reads them), else its
     /// count ([`PixelBuffers::hold_rows`]). Called before any sample is added.
     pub fn hold_rows(&mut self, keep_stats: bool, window: usize) {
         if let Some(b) = self.buffers.as_mut() {

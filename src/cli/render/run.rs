@@ -50,11 +50,8 @@ pub(super) fn render_scene(
     job: &mut Job,
     target: &Target,
 ) -> Result<Rendered, String> {
-    // The spp and variance AOVs read every pixel's statistics.
-    let keep_stats = target
-        .aovs
-        .iter()
-        .any(|a| matches!(a.name.as_str(), "spp" | "variance"));
+    // The variance AOV reads every pixel's statistics (the spp AOV its count, kept anyway).
+    let keep_stats = target.aovs.iter().any(|a| a.name == "variance");
     let window = job
         .by_bands
         .then(|| Bands::window(job.plugins.filter.as_ref(), job.size().1))
