@@ -58,9 +58,24 @@ impl Plugins {
     /// An empty film for `scene`, splatting with the filter's kernel, and collecting the cells
     /// the filter needs when the sampler keeps none.
     pub fn film(&self, scene: &crate::scene::Scene) -> Film {
+        self.film_by_rows(scene, None)
+    }
+
+    /// [`Plugins::film`]; with `by_rows`, for a render by bands ([`crate::render::Bands`]):
+    /// the half buffers hold the rows under way, `by_rows` the room for them and whether the
+    /// rows released keep their statistics ([`Film::keep_pixel_buffers_by_rows`]).
+    pub fn film_by_rows(
+        &self,
+        scene: &crate::scene::Scene,
+        by_rows: Option<(usize, bool)>,
+    ) -> Film {
         let mut film = Film::new(scene.film.clone(), self.filter.kernel());
         if self.filter.reads_pixel_buffers() {
-            film.keep_pixel_buffers();
+            match by_rows {
+                Some((window, keep_stats)) => film.keep_pixel_buffers_by_rows(keep_stats, window),
+                None => film.keep_pixel_buffers(),
+            }
+            film.set_depth_scale(crate::render::bands::depth_scale(scene));
         }
         if let Some((cell_size, bins)) = self.filter.cell_layout() {
             let features = self.filter.reads_features();
@@ -76,7 +91,6 @@ impl Plugins {
     /// has one, plus the film's unfiltered splats, times the film's `scale`; row-major over the
     /// cropped film.
     pub fn image(&self, film: &Film) -> Vec<Spectrum> {
-        let scale = film.settings().scale;
         let filtered = |film: &Film| {
             self.filter.reconstruct(
                 film,
@@ -95,6 +109,13 @@ impl Plugins {
                 film.per_stream(|f, _| filtered(f))
             }
         });
+        self.finish_image(film, reconstructed)
+    }
+
+    /// `reconstructed` (of `film`, row-major over the cropped film) with the film's unfiltered
+    /// splats added, times its `scale`: the image.
+    pub fn finish_image(&self, film: &Film, reconstructed: Vec<Spectrum>) -> Vec<Spectrum> {
+        let scale = film.settings().scale;
         film.with_splats(reconstructed)
             .into_iter()
             .map(|c| c * scale)

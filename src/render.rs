@@ -16,8 +16,10 @@ use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
 pub use acr_plugins::sampler::MAX_SPP;
+pub use bands::{render_in_bands, Banded, Bands};
 pub use stop::{Checkpoint, ErrorEstimate, Halt, RenderCounts, Stop};
 
+pub mod bands;
 pub mod stop;
 
 /// The part of the rendering space a scene's render covers: its film's crop and its dims.
@@ -167,6 +169,9 @@ struct Traced {
     handed: u64,
     /// The full film's pixels.
     full_pixels: u64,
+    /// Walking by rows, the rows whose every sample the batches up to this one hold
+    /// ([`Sampler::rows_given`]).
+    rows_given: u32,
 }
 
 impl Traced {
@@ -263,7 +268,26 @@ pub fn render_with(
     seed: u64,
     stop: &Stop,
     progress: Option<&indicatif::ProgressBar>,
+    features: Option<&mut FeatureImage>,
+) -> RenderCounts {
+    render_loop(
+        scene, li, sampler, film, seed, stop, progress, features, None,
+    )
+}
+
+/// [`render_with`], and with `bands`, a render by bands: each band filtered once the film
+/// holds its rows and halo ([`Bands::rows_in`]), between batches.
+#[allow(clippy::too_many_arguments)]
+fn render_loop(
+    scene: &Scene,
+    li: &Estimator<'_>,
+    sampler: &mut dyn Sampler,
+    film: &mut Film,
+    seed: u64,
+    stop: &Stop,
+    progress: Option<&indicatif::ProgressBar>,
     mut features: Option<&mut FeatureImage>,
+    mut bands: Option<&mut Bands<'_>>,
 ) -> RenderCounts {
     let space = rendering_space(scene);
     let mut watch = Watch::new(stop, space.pixels().max(1));
@@ -297,6 +321,8 @@ pub fn render_with(
     let last_pixel = space.pixel(space.pixels().saturating_sub(1));
     let in_passes = sampler.whole_passes();
     let mut more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
+    // The rows whose every sample the batches up to `batch` hold (walking by rows).
+    let mut rows_given = sampler.rows_given();
     while more {
         // While `batch` is traced, the sampler and the film take the batch before and, when
         // the sampler plans ahead, it plans the next.
@@ -307,10 +333,18 @@ pub fn render_with(
                 if pending {
                     traced.hand_over(sampler, film, &mut in_sampler);
                 }
-                ahead.then(|| timed(&mut in_sampler, || sampler.next_batch(&mut next)))
+                ahead.then(|| {
+                    let more = timed(&mut in_sampler, || sampler.next_batch(&mut next));
+                    (more, sampler.rows_given())
+                })
             },
         );
+        if let (true, Some(b)) = (pending, bands.as_deref_mut()) {
+            // Filtered between batches, not while one is traced: the filter's time is its own.
+            b.rows_in(film, traced.rows_given);
+        }
         std::mem::swap(&mut traced.batch, &mut batch);
+        traced.rows_given = rows_given;
         traced.take(&results, film, &mut counts, features.as_deref_mut());
         pending = true;
         if let Some(p) = progress {
@@ -323,22 +357,30 @@ pub fn render_with(
         watch.check(film, sampler, &mut counts);
         watch.plan_to_time(sampler, &counts);
         match planned {
-            Some(planned) => {
+            Some((planned, rows)) => {
                 std::mem::swap(&mut batch, &mut next);
                 more = planned;
+                rows_given = rows;
             }
             None => {
                 traced.hand_over(sampler, film, &mut in_sampler);
                 pending = false;
+                if let Some(b) = bands.as_deref_mut() {
+                    b.rows_in(film, traced.rows_given);
+                }
                 // A sampler that asks for guidance plans nothing ahead meanwhile: the film
                 // now holds every batch it gave.
                 answer_guidance(sampler, film, stop.estimated_error, &mut in_sampler);
                 more = timed(&mut in_sampler, || sampler.next_batch(&mut batch));
+                rows_given = sampler.rows_given();
             }
         }
     }
     if pending {
         traced.hand_over(sampler, film, &mut in_sampler);
+        if let Some(b) = bands {
+            b.rows_in(film, traced.rows_given);
+        }
     }
     counts.halted = counts.samples < space.pixels() * u64::from(sampler.spp());
     watch.say_why_halted(&mut counts);

@@ -144,18 +144,19 @@ impl Output {
     /// mergeable when asked or when the render was stopped by a signal and can be merged.
     /// `spp` is what each pixel was planned to get; a halted render records what it reached.
     pub fn write_final(&self, image: &[Spectrum], film: &Film, end: &End) -> Result<(), String> {
-        // Computed once: with half buffers every call makes the whole image's statistics.
-        let stats = film.pixel_stats();
+        // Computed once, and only when read: with half buffers every call makes the whole
+        // image's statistics.
+        let stats = (end.halted || !self.channel_aovs.is_empty()).then(|| film.pixel_stats());
+        let stats = stats.as_deref().unwrap_or_default();
         let mut aovs = Vec::new();
         for name in &self.channel_aovs {
-            aovs.extend(channel_values(name, &stats, self.scale, end.features)?);
+            aovs.extend(channel_values(name, stats, self.scale, end.features)?);
         }
         let spp = if end.halted {
-            reached_spp(&stats)
+            reached_spp(stats)
         } else {
             end.spp
         };
-        drop(stats);
         if self.writes_sums(end.signalled) {
             let mut sums = self.sums(film, spp, end.seconds)?;
             // What the sums already hold is not written twice.

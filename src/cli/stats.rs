@@ -73,6 +73,9 @@ pub struct Stats {
     /// Clusters the polynomial reconstruction fitted at degree 0, 1 and 2 (null for other
     /// filters).
     pub fitted_by_degree: Option<[u64; 3]>,
+    /// A render by bands (docs/reconstruction.md, "Rendering by bands"): the bands its filter
+    /// made as the samples came in (null when the image was made at the end).
+    pub bands: Option<u64>,
     /// Samples dropped for NaN, infinite or negative radiance.
     pub dropped_samples: u64,
     /// Time per phase.

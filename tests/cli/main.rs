@@ -2,6 +2,7 @@
 //! errors) and `acr diff`, as docs/cli.md specifies them.
 
 mod aovs;
+mod bands;
 mod errors;
 mod output;
 mod pipeline;

@@ -135,6 +135,54 @@ impl Film {
         self.buffers.as_deref()
     }
 
+    /// Sets the half buffers' depth scale ([`PixelBuffers::set_depth_scale`]), when kept.
+    pub fn set_depth_scale(&mut self, scale: f32) {
+        if let Some(b) = self.buffers.as_mut() {
+            b.set_depth_scale(scale);
+        }
+    }
+
+    /// A render by bands (docs/reconstruction.md, "Rendering by bands"): the half buffers hold
+    /// the rows under way only, room made for `window` rows, and of the rows released each
+    /// pixel's statistics when `keep_stats` (the variance AOV reads them), else its
+    /// count ([`PixelBuffers::hold_rows`]). Called before any sample is added.
+    pub fn hold_rows(&mut self, keep_stats: bool, window: usize) {
+        if let Some(b) = self.buffers.as_mut() {
+            b.hold_rows(keep_stats, window);
+        }
+    }
+
+    /// [`Film::keep_pixel_buffers`] for a render by bands ([`Film::hold_rows`]), the whole
+    /// image's halves never made.
+    pub fn keep_pixel_buffers_by_rows(&mut self, keep_stats: bool, window: usize) {
+        self.sums = Vec::new();
+        self.stats = Vec::new();
+        let [cx0, _, cy0, _] = self.settings.crop;
+        let (w, h) = self.settings.size();
+        self.buffers = Some(Box::new(PixelBuffers::by_rows_of(
+            w,
+            h,
+            [cx0, cy0],
+            keep_stats,
+            window,
+        )));
+    }
+
+    /// In a render by bands, makes the half buffers hold every row above crop row `row`
+    /// ([`PixelBuffers::hold_through`]).
+    pub fn hold_through(&mut self, row: usize) {
+        if let Some(b) = self.buffers.as_mut() {
+            b.hold_through(row);
+        }
+    }
+
+    /// In a render by bands, frees the half buffers' rows above crop row `row`.
+    pub fn release_rows(&mut self, row: usize) {
+        if let Some(b) = self.buffers.as_mut() {
+            b.release_rows(row);
+        }
+    }
+
     /// Keeps the two sample streams of a paired sampler apart (a sample's stream is its
     /// index's parity): each gets a film of its own, and the image is their blend with the
     /// fixed weights `first_weight` and 1 minus it, so that neither stream's share of a pixel
@@ -388,7 +436,9 @@ impl Film {
     /// streams are split: the image is then a mean of two films). With half buffers, the
     /// pixel's own samples' sums and count (a box of one pixel).
     pub fn weighted_sums(&self) -> Option<Cow<'_, [[f64; 4]]>> {
-        if self.halves.is_some() {
+        if self.halves.is_some() || self.buffers.as_ref().is_some_and(|b| b.by_rows()) {
+            // Split streams make the image a mean of two films; a render by bands keeps no
+            // sums of the rows it released.
             return None;
         }
         Some(match &self.buffers {
@@ -410,7 +460,8 @@ impl Film {
     /// the largest part of the film (32 bytes a pixel; the halves 176), and the output is
     /// written after. [`Film::pixels`] and [`Film::weighted_sums`] are then empty.
     pub fn release_sums(&mut self) {
-        if let Some(b) = self.buffers.take() {
+        // A render by bands holds no halves by now, only what it kept of each pixel.
+        if let Some(b) = self.buffers.take_if(|b| !b.by_rows()) {
             self.stats = b.pixel_stats();
         }
         self.sums = Vec::new();

@@ -1,6 +1,7 @@
 //! pbrt-v3's pixel reconstruction filters: each sample is splatted into every pixel whose
 //! centre lies within the filter's radius, weighted by the filter at the offset.
 
+mod band_plan;
 mod boxf;
 mod gaussian;
 mod mitchell;
@@ -9,6 +10,7 @@ mod polynomial;
 mod sinc;
 mod triangle;
 
+pub use band_plan::BandPlan;
 pub use boxf::BoxFilter;
 pub use gaussian::GaussianFilter;
 pub use mitchell::MitchellFilter;
@@ -75,6 +77,24 @@ pub trait Filter: Send + Sync {
     /// None for a filter that makes no such estimate.
     fn estimated_error(&self, _film: &Film) -> Option<Vec<f32>> {
         None
+    }
+
+    /// How the filter makes an image of `height` rows band by band in a render by bands
+    /// (docs/reconstruction.md, "Rendering by bands"): each band of rows from those rows and
+    /// its halo alone, so that the film need hold no more; None for a filter that needs the
+    /// whole film at once.
+    fn bands(&self, height: usize) -> Option<BandPlan> {
+        let _ = height;
+        None
+    }
+
+    /// The image's rows `rows` (crop rows, a band of [`Filter::bands`]'s layout), from a film
+    /// that holds at least the rows [`BandPlan::read`] names; by default, from the whole film.
+    fn reconstruct_rows(&self, film: &Film, rows: std::ops::Range<usize>) -> Vec<Spectrum> {
+        let w = film.settings().size().0 as usize;
+        let mut image = self.reconstruct(film, SamplerOutput::default());
+        image.truncate(rows.end * w);
+        image.split_off(rows.start * w)
     }
 }
 

@@ -138,6 +138,22 @@ pub trait Sampler: Send {
         false
     }
 
+    /// Walks the space `rows` rows at a time from the top, every sample of those rows given
+    /// before any of the next rows' (a render by bands, docs/reconstruction.md), each pixel's
+    /// samples in the order and with the values of the usual walk; says whether it does. Only
+    /// a sampler whose points depend on the pixel and index alone can; by default it does not.
+    /// Called before the first batch.
+    fn walk_by_rows(&mut self, rows: u32) -> bool {
+        let _ = rows;
+        false
+    }
+
+    /// Walking by rows, the rows from the space's top whose every sample the batches given so
+    /// far hold (0 otherwise).
+    fn rows_given(&self) -> u32 {
+        0
+    }
+
     /// Gives sample indices `offset` to `offset + spp` of each pixel instead of 0 to `spp`
     /// (Cycles' sample offset), so that renders of consecutive ranges add up to one of them
     /// all. Only a sampler whose points depend on the index alone can; it says whether it did.
@@ -611,6 +627,51 @@ pub(crate) mod tests {
         assert!(s.next_batch(&mut b));
         s.halt();
         assert!(!s.next_batch(&mut b));
+    }
+
+    #[test]
+    fn walking_by_rows_gives_each_pixel_the_same_points_band_after_band() {
+        // 3 rows at a time over 7 rows (the last chunk short), a crop not at the origin.
+        let sp = space(5, 6, 300, 7, ALL_DIMS[3]);
+        for (mut whole, mut banded) in all(sp, 9, 4).into_iter().zip(all(sp, 9, 4)) {
+            let name = whole.name();
+            assert!(banded.walk_by_rows(3), "{name}");
+            let a = by_pixel(&sp, &batches(whole.as_mut()));
+            let mut rows = Vec::new();
+            let mut got = Vec::new();
+            let mut b = Vec::new();
+            while banded.next_batch(&mut b) {
+                // Every point lies below the rows given before it.
+                let given = rows.last().copied().unwrap_or(0);
+                assert!(b.iter().all(|q| q.pixel[1] - sp.y0 >= given), "{name}");
+                rows.push(banded.rows_given());
+                got.extend_from_slice(&b);
+            }
+            rows.dedup();
+            assert_eq!(
+                rows.iter().filter(|&&r| r > 0).count(),
+                3,
+                "{name}: {rows:?}"
+            );
+            assert_eq!(rows.last(), Some(&7), "{name}");
+            // Each pixel's points in the same order, with the same values.
+            let mut per_pixel: Vec<SamplePoint> = got.clone();
+            per_pixel.sort_by_key(|q| (q.pixel[1], q.pixel[0]));
+            assert_eq!(per_pixel, a, "{name}");
+        }
+        // Halted in the second chunk: its pass completes, the third chunk is never given.
+        let mut s = StratifiedSampler::new(space(0, 0, 4000, 30, ALL_DIMS[0]), 4, 4, true, 1);
+        assert!(s.walk_by_rows(10));
+        let mut b = Vec::new();
+        while s.rows_given() < 10 {
+            assert!(s.next_batch(&mut b));
+        }
+        assert!(s.next_batch(&mut b));
+        s.halt();
+        while s.next_batch(&mut b) {
+            assert!(b.iter().all(|q| q.pixel[1] < 20));
+        }
+        assert_eq!(s.rows_given(), 10);
     }
 
     #[test]

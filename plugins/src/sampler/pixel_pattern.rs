@@ -21,6 +21,13 @@ pub(crate) struct PixelCursor {
     pass_start: u32,
     next_pixel: u64,
     halted: bool,
+    /// Rows walked at a time ([`Sampler::walk_by_rows`]; 0: the whole space): every sample of
+    /// a chunk of rows is given before the next chunk's.
+    chunk_rows: u32,
+    /// The chunk under way.
+    chunk: u32,
+    /// Rows, from the space's top, whose every sample has been given.
+    rows_given: u32,
 }
 
 impl PixelCursor {
@@ -31,11 +38,46 @@ impl PixelCursor {
             space,
             spp,
             offset: 0,
-            pass_len: (BATCH_SAMPLES / pixels).clamp(1, u64::from(spp.max(1))) as u32,
+            pass_len: Self::pass_len(pixels, spp),
             pass_start: 0,
             next_pixel: 0,
             halted: false,
+            chunk_rows: 0,
+            chunk: 0,
+            rows_given: 0,
         }
+    }
+
+    /// Walks the space `rows` rows at a time (0: all at once), from the first pixel.
+    pub(crate) fn walk_by_rows(&mut self, rows: u32) {
+        self.chunk_rows = rows;
+        self.chunk = 0;
+        self.next_pixel = 0;
+        self.pass_start = 0;
+        self.pass_len = Self::pass_len(self.chunk_pixels().end, self.spp);
+    }
+
+    /// Samples a pixel gets in each pass over `pixels` pixels: as many as keep a pass near a
+    /// batch.
+    fn pass_len(pixels: u64, spp: u32) -> u32 {
+        (BATCH_SAMPLES / pixels.max(1)).clamp(1, u64::from(spp.max(1))) as u32
+    }
+
+    /// The row-major pixel indices of the chunk under way.
+    fn chunk_pixels(&self) -> Range<u64> {
+        let total = self.space.pixels();
+        if self.chunk_rows == 0 {
+            return 0..total;
+        }
+        let w = u64::from(self.space.x1 - self.space.x0);
+        let rows = u64::from(self.chunk_rows) * w;
+        let start = (u64::from(self.chunk) * rows).min(total);
+        start..(start + rows).min(total)
+    }
+
+    /// Rows, from the space's top, whose every sample the batches given so far hold.
+    pub(crate) fn rows_given(&self) -> u32 {
+        self.rows_given
     }
 
     /// The space walked.
@@ -59,29 +101,45 @@ impl PixelCursor {
         if !self.has_next() {
             return None;
         }
-        let total = self.space.pixels();
+        let chunk = self.chunk_pixels();
         let n = self.pass_len.min(self.spp - self.pass_start);
         // A pixel with more than a batch's samples forms a batch alone.
         let per_batch = (BATCH_SAMPLES / u64::from(n)).max(1);
-        let end = (self.next_pixel + per_batch).min(total);
+        let end = (self.next_pixel + per_batch).min(chunk.end);
         let first = self.pass_start.saturating_add(self.offset);
         let batch = (self.next_pixel..end, first..first.saturating_add(n));
         self.next_pixel = end;
-        if end == total {
-            self.next_pixel = 0;
+        if end == chunk.end {
+            self.next_pixel = chunk.start;
             self.pass_start = if self.halted {
                 self.spp
             } else {
                 self.pass_start + n
             };
+            if self.pass_start >= self.spp && !self.halted {
+                self.next_chunk(chunk.end);
+            }
         }
         Some(batch)
+    }
+
+    /// The chunk ending at pixel `end` is given whole: on to the next one, if any.
+    fn next_chunk(&mut self, end: u64) {
+        let w = u64::from(self.space.x1 - self.space.x0).max(1);
+        self.rows_given = (end.div_ceil(w)).min(u64::from(u32::MAX)) as u32;
+        if end < self.space.pixels() {
+            self.chunk += 1;
+            self.pass_start = 0;
+            let chunk = self.chunk_pixels();
+            self.next_pixel = chunk.start;
+            self.pass_len = Self::pass_len(chunk.end - chunk.start, self.spp);
+        }
     }
 
     /// The fewest samples per pixel the walk can still end at: the passes given and the one
     /// under way (at least 1).
     pub(crate) fn floor(&self) -> u32 {
-        let under_way = if self.next_pixel > 0 {
+        let under_way = if self.next_pixel > self.chunk_pixels().start {
             self.pass_len.min(self.spp - self.pass_start)
         } else {
             0
@@ -99,7 +157,9 @@ impl PixelCursor {
     /// Ends the walk after the current pass (after the first pass, if none is complete yet).
     pub(crate) fn halt(&mut self) {
         self.halted = true;
-        if self.next_pixel == 0 && self.pass_start > 0 {
+        let at_start = self.next_pixel == self.chunk_pixels().start;
+        // Between passes, or before a chunk's first pass once an earlier chunk is whole.
+        if at_start && (self.pass_start > 0 || self.chunk > 0) {
             self.pass_start = self.spp;
         }
     }
@@ -194,6 +254,16 @@ impl<T: PixelPattern> Sampler for T {
 
     fn whole_passes(&self) -> bool {
         true
+    }
+
+    fn walk_by_rows(&mut self, rows: u32) -> bool {
+        // Its points depend on the pixel and index alone, not on the order of the walk.
+        self.cursor_mut().walk_by_rows(rows);
+        true
+    }
+
+    fn rows_given(&self) -> u32 {
+        self.cursor().rows_given()
     }
 
     fn set_sample_offset(&mut self, offset: u32) -> bool {

@@ -66,7 +66,9 @@ pub(super) fn stats(
     let (w, h) = job.size();
     let counts = &rendered.counts;
     let plugins = &job.plugins;
-    let render_s = clock.render_seconds();
+    // A render by bands filtered as it went: that time is the reconstruction's.
+    let banded_s = rendered.banded.as_ref().map_or(0.0, |b| b.seconds);
+    let render_s = clock.render_seconds() - banded_s;
     let report = plugins.sampler.report();
     Stats {
         scene: args.scene.display().to_string(),
@@ -94,6 +96,7 @@ pub(super) fn stats(
         cells: report.cells,
         rounds: report.rounds,
         fitted_by_degree: plugins.filter.report().fitted_by_degree,
+        bands: rendered.banded.as_ref().map(|b| b.bands),
         dropped_samples: counts.dropped,
         seconds: Seconds {
             parse: (clock.parsed - clock.start).as_secs_f64(),
@@ -102,7 +105,7 @@ pub(super) fn stats(
             sampler: counts.sampler_seconds,
             replay: cost.map(|c| c.replay),
             rerender: cost.map(|c| c.render),
-            reconstruct: (clock.reconstructed - clock.measured).as_secs_f64(),
+            reconstruct: (clock.reconstructed - clock.measured).as_secs_f64() + banded_s,
             write: (clock.written - clock.reconstructed).as_secs_f64(),
             total: clock.start.elapsed().as_secs_f64(),
         },

@@ -77,7 +77,13 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     // The measure's renders are no part of the reconstruction.
     clock.measured = Instant::now();
 
-    let image = job.plugins.image(&rendered.film);
+    let image = match rendered.banded.as_mut() {
+        // A render by bands made its image as it went.
+        Some(b) => job
+            .plugins
+            .finish_image(&rendered.film, std::mem::take(&mut b.image)),
+        None => job.plugins.image(&rendered.film),
+    };
     clock.reconstructed = Instant::now();
     finish::write_image_and_aovs(args, &job, &target, &mut rendered, &image, &clock)?;
     clock.written = Instant::now();

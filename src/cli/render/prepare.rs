@@ -47,6 +47,8 @@ pub(super) struct Job {
     /// Whether the film splats each sample with the filter's kernel (neither the filter's
     /// cells nor the sampler make the image).
     pub(super) splats: bool,
+    /// Whether it renders by bands ([`by_bands`]; the sampler then walks by rows).
+    pub(super) by_bands: bool,
 }
 
 impl Job {
@@ -89,6 +91,7 @@ impl Job {
                 plugins.filter.name()
             ));
         }
+        let by_bands = by_bands(args, &mut plugins, scene.film.size().1);
         print_warnings(&desc, warnings);
         if let Some(row) = auto {
             eprintln!("{}", pipeline::announce(row));
@@ -101,6 +104,7 @@ impl Job {
             reserve,
             plugins,
             splats,
+            by_bands,
         })
     }
 
@@ -108,6 +112,36 @@ impl Job {
     pub(super) fn size(&self) -> (u32, u32) {
         self.scene.film.size()
     }
+}
+
+/// Whether the render goes by bands of rows (docs/reconstruction.md, "Rendering by bands"):
+/// when the filter makes the image band by band and the image has more than one band, the
+/// sampler's points depend on the pixel and index alone (it is then set to walk by rows), the
+/// integrator samples the camera's pixels (not mlt, sppm, nor bdpt, whose light paths splat
+/// anywhere), and nothing needs the whole film before the end: no time limit nor noise
+/// threshold (which stop the image as a whole), no mergeable sums, partial images, viewer or
+/// sampler-cost replay.
+fn by_bands(args: &RenderArgs, plugins: &mut Plugins, height: u32) -> bool {
+    let bands = plugins.filter.bands(height as usize);
+    let several = bands.is_some_and(|b| b.layout(height as usize).len() > 1);
+    let camera_pixels = !matches!(
+        plugins.integrator,
+        Integrator::Mlt(_) | Integrator::Sppm(_) | Integrator::Bdpt(_)
+    );
+    let whole_film_later = args.time_limit.is_none()
+        && args.noise_threshold.is_none()
+        && !args.mergeable
+        && args.write_partial_images.is_none()
+        && args.display_server.is_none()
+        && !args.sampler_cost;
+    several
+        && camera_pixels
+        && whole_film_later
+        && plugins.filter.reads_pixel_buffers()
+        && plugins.sampler.streams() == 1
+        && plugins
+            .sampler
+            .walk_by_rows(crate::render::bands::CHUNK_ROWS)
 }
 
 /// The scene built, cropped by `--cropwindow` or `--pixelbounds`.

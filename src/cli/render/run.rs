@@ -10,7 +10,8 @@ use crate::cli::output::Output;
 use crate::cli::replay::Recording;
 use crate::first_hit::FeatureImage;
 use crate::integrator::Integrator;
-use crate::render::{render_with_features, Checkpoint, Halt, RenderCounts, Stop};
+use crate::render::{render_in_bands, render_with_features, Banded, Bands, Checkpoint, Halt};
+use crate::render::{RenderCounts, Stop};
 use acr_plugins::{Film, SamplePoint, Sampler};
 use std::io::IsTerminal;
 use std::sync::atomic::AtomicBool;
@@ -31,6 +32,8 @@ pub(super) struct Rendered {
     pub(super) batches: Option<Vec<Vec<SamplePoint>>>,
     /// Samples per pixel planned.
     pub(super) spp: u32,
+    /// A render by bands: the image its filter made band by band.
+    pub(super) banded: Option<Banded>,
 }
 
 impl Rendered {
@@ -47,7 +50,15 @@ pub(super) fn render_scene(
     job: &mut Job,
     target: &Target,
 ) -> Result<Rendered, String> {
-    let mut film = job.plugins.film(&job.scene);
+    // The variance AOV reads every pixel's statistics (the spp AOV its count, kept anyway).
+    let keep_stats = target.aovs.iter().any(|a| a.name == "variance");
+    let window = job
+        .by_bands
+        .then(|| Bands::window(job.plugins.filter.as_ref(), job.size().1))
+        .flatten();
+    let mut film = job
+        .plugins
+        .film_by_rows(&job.scene, window.map(|w| (w, keep_stats)));
     let bar = progress_bar(args.quiet);
     let spp = match &job.plugins.integrator {
         // What mlt's --spp sets.
@@ -90,16 +101,36 @@ pub(super) fn render_scene(
         FeatureImage::new(x0, x1, y0, y1)
     });
     crate::integrator::bdpt::begin_render(&job.plugins.integrator, &job.scene);
-    let counts = render_with_features(
-        &job.scene,
-        &job.plugins.integrator,
-        sampler,
-        &mut film,
-        args.seed,
-        &stop,
-        bar.as_ref(),
-        features.as_mut(),
-    );
+    let bands = window.and_then(|_| Bands::new(&job.scene, filter.as_ref(), sampler, &film));
+    let (counts, banded) = match bands {
+        Some(mut bands) => {
+            let counts = render_in_bands(
+                &job.scene,
+                &job.plugins.integrator,
+                sampler,
+                &mut film,
+                args.seed,
+                &stop,
+                bar.as_ref(),
+                features.as_mut(),
+                &mut bands,
+            );
+            (counts, Some(bands.finish(&mut film)))
+        }
+        None => {
+            let counts = render_with_features(
+                &job.scene,
+                &job.plugins.integrator,
+                sampler,
+                &mut film,
+                args.seed,
+                &stop,
+                bar.as_ref(),
+                features.as_mut(),
+            );
+            (counts, None)
+        }
+    };
     warn_of_non_finite_features(features.as_ref(), &counts);
     crate::integrator::bdpt::end_render(
         &job.plugins.integrator,
@@ -118,6 +149,7 @@ pub(super) fn render_scene(
         display: looks.display,
         batches,
         spp,
+        banded,
     })
 }
 

@@ -63,8 +63,10 @@ fn output_of(args: &RenderArgs, job: &Job, path: PathBuf, is_exr: bool) -> Outpu
         mergeable: args.mergeable,
         // mlt's image is normalised by its own bootstrap: its ranges do not add up; sppm's
         // image is not a sum of samples: nothing to merge.
+        // A render by bands keeps no sums of the rows it released.
         can_merge: is_exr
             && job.splats
+            && !job.by_bands
             && job.plugins.sampler.streams() == 1
             && !matches!(
                 job.plugins.integrator,

@@ -14,7 +14,7 @@ mod planes;
 mod regression;
 mod selection;
 
-use super::{BoxFilter, Filter, FilterBuild, FilterKernel, SamplerOutput};
+use super::{BandPlan, BoxFilter, Filter, FilterBuild, FilterKernel, SamplerOutput};
 use crate::film::{Film, PixelBuffers, Spectrum};
 use crate::first_hit::FEATURES;
 use crate::registry::{float_in, int_in, Choice, Entry, Kind, ParamSpec, PluginInfo};
@@ -38,7 +38,8 @@ pub const SELECT_RADIUS: u32 = 3;
 pub const RIDGE: f64 = 1e-3;
 /// The rows of a band by default: the image is filtered a band of rows at a time, each with
 /// a halo of the windows' reach, so that the filter's planes are a band's, not the image's
-/// (docs/reconstruction.md, "Memory").
+/// (docs/reconstruction.md, "Memory"). A render by bands takes fewer on images over
+/// 2 x BAND rows ([`NforFilter::render_band`]).
 pub const BAND: u32 = 256;
 /// The regressions' fits on every STRIDE-th pixel in each direction by default
 /// (docs/reconstruction.md, "Cost").
@@ -60,7 +61,7 @@ const SECOND_PASS_K: f32 = 1.0;
 const PREFILTER_K: f32 = 0.5;
 
 /// The NFOR reconstruction.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct NforFilter {
     radius: usize,
     patch: usize,
@@ -71,8 +72,9 @@ pub struct NforFilter {
     stride: usize,
     /// Whether NFOR's second pass runs.
     second_pass: bool,
-    /// The rows of a band (0: the whole image at once).
-    band: usize,
+    /// The rows of a band (0: the whole image at once; None: by default, [`BAND`], or in a
+    /// render by bands [`NforFilter::render_band`]).
+    band: Option<usize>,
     /// The film keeps pixel statistics only: a box of one pixel.
     kernel: BoxFilter,
 }
@@ -94,7 +96,7 @@ impl NforFilter {
             ridge: ridge as f32,
             stride: STRIDE as usize,
             second_pass: true,
-            band: BAND as usize,
+            band: None,
             kernel: BoxFilter::new(0.5, 0.5),
         }
     }
@@ -111,10 +113,35 @@ impl NforFilter {
         self
     }
 
+    /// The filter with bands of `rows` rows, or by default ([`NforFilter::render_band`]).
+    fn with_band_or_default(self, rows: Option<u32>) -> Self {
+        match rows {
+            Some(rows) => self.with_band(rows),
+            None => self,
+        }
+    }
+
     /// The filter with bands of `rows` rows (0: the whole image at once).
     pub fn with_band(mut self, rows: u32) -> Self {
-        self.band = rows as usize;
+        self.band = Some(rows as usize);
         self
+    }
+
+    /// The rows of a band in a render by bands of an image of `height` rows, by default: the
+    /// half buffers and the filter's planes of a band and its halo are about 370 bytes a
+    /// pixel, the splatting film's whole image 60, so a band and its halo over a quarter of
+    /// the image keep the peak near 1.5 times a splatting render's (docs/reconstruction.md,
+    /// "Rendering by bands"): that many rows, on the tile grid, 64 to [`BAND`]. Images of
+    /// up to 2 x BAND rows keep BAND (a band or two: smaller bands would cost time there).
+    fn render_band(&self, height: usize, halo: usize) -> usize {
+        if let Some(b) = self.band {
+            return b;
+        }
+        let band = BAND as usize;
+        if height <= 2 * band {
+            return band;
+        }
+        ((height / 4).saturating_sub(2 * halo) / TILE * TILE).clamp(64, band)
     }
 
     /// How far, in pixels, the filtered value of a pixel reaches into its inputs: the sum of
@@ -135,6 +162,21 @@ impl NforFilter {
         }
     }
 
+    /// The bands of `band` rows (with `second`, for the second pass's reach too): a halo that
+    /// covers [`NforFilter::reach`], band and halo on the tile grid.
+    fn plan(&self, band: usize, second: bool) -> BandPlan {
+        BandPlan {
+            rows: band.next_multiple_of(TILE),
+            halo: self.reach(second).next_multiple_of(TILE),
+        }
+    }
+
+    /// The bands of a render by bands of an image of `height` rows.
+    fn render_plan(&self, height: usize) -> BandPlan {
+        let halo = self.plan(0, self.second_pass).halo;
+        self.plan(self.render_band(height, halo), self.second_pass)
+    }
+
     /// The filtered image and its estimated per-pixel MSE (bandwidths `ks`; with `second`,
     /// the second pass too), band by band: `take` gets each band's image and MSE (over the
     /// band's rows with their halo) and the band's own rows within them, top band first.
@@ -149,19 +191,11 @@ impl NforFilter {
     ) {
         let h = b.size().1 as usize;
         let depth = depth_scale(b);
-        let band = match self.band {
-            0 => h.max(1),
-            n => n.next_multiple_of(TILE),
-        };
-        let halo = self.reach(second).next_multiple_of(TILE);
-        let mut y = 0;
-        while y < h {
-            // A remainder within the halo joins its band: those rows are read anyway.
-            let end = if y + band + halo >= h { h } else { y + band };
-            let rows = y.saturating_sub(halo)..(end + halo).min(h);
+        let plan = self.plan(self.band.unwrap_or(BAND as usize), second);
+        for band in plan.layout(h) {
+            let rows = plan.read(&band, h);
             let (image, mse) = self.denoise(b, rows.clone(), depth, ks, second);
-            take(&image, &mse, y - rows.start..end - rows.start);
-            y = end;
+            take(&image, &mse, band.start - rows.start..band.end - rows.start);
         }
     }
 
@@ -334,6 +368,35 @@ impl Filter for NforFilter {
         out
     }
 
+    fn bands(&self, height: usize) -> Option<BandPlan> {
+        (self.band != Some(0)).then(|| self.render_plan(height))
+    }
+
+    fn reconstruct_rows(&self, film: &Film, rows: Range<usize>) -> Vec<Spectrum> {
+        let Some(b) = film.pixel_buffers() else {
+            let w = film.settings().size().0 as usize;
+            let stats = film.pixel_stats();
+            return stats[rows.start * w..rows.end * w]
+                .iter()
+                .map(|s| s.mean())
+                .collect();
+        };
+        let h = b.size().1 as usize;
+        let read = self.render_plan(h).read(&rows, h);
+        let (image, _) = self.denoise(
+            b,
+            read.clone(),
+            depth_scale(b),
+            &BANDWIDTHS,
+            self.second_pass,
+        );
+        let span = (rows.start - read.start) * image.w * 3..(rows.end - read.start) * image.w * 3;
+        image.data[span]
+            .chunks(3)
+            .map(|c| Spectrum::new(c[0], c[1], c[2]).max(Spectrum::ZERO))
+            .collect()
+    }
+
     fn estimated_error(&self, film: &Film) -> Option<Vec<f32>> {
         // One bandwidth: half the regression's cost, for a sampler that asks mid-render.
         let b = film.pixel_buffers()?;
@@ -388,9 +451,11 @@ pub(crate) const ENTRY: Entry<FilterBuild> = Entry {
             ParamSpec::new(
                 "band",
                 ParamType::Integer,
-                "256",
+                "-1",
                 "rows filtered at a time, each band with a halo of the windows' reach: less \
-                 memory, more time; the image is the same (0: the whole image at once)",
+                 memory, more time; the image is the same (0: the whole image at once, no \
+                 render by bands; -1: 256, or in a render by bands of over 512 rows a quarter \
+                 of the image less the halo, 64 to 256)",
             ),
             ParamSpec::new(
                 "stride",
@@ -420,7 +485,11 @@ fn build(c: &Choice) -> Result<Box<dyn Filter>> {
             float_in(p, "ridge", RIDGE, 0.0..=1e3)?,
         )
         .with_second_pass(p.bool_or("secondpass", true)?)
-        .with_band(int_in(p, "band", BAND as i32, 0..=1 << 16)?)
+        .with_band_or_default(match p.int_or("band", -1)? {
+            // The default: by the image's height.
+            -1 => None,
+            _ => Some(int_in(p, "band", -1, 0..=1 << 16)?),
+        })
         .with_stride(int_in(p, "stride", STRIDE as i32, 1..=4)? as u32),
     ))
 }

@@ -180,10 +180,15 @@ fn half_variance<const N: usize>(
     }
 }
 
-/// The factor that brings depth to the scale of the image's mean depth (over both halves of
-/// every pixel with a first hit), so that one ridge suits every scene: computed over the whole
-/// image, whatever part of it is filtered.
+/// The factor that brings depth to the scale of the image's mean depth, so that one ridge
+/// suits every scene: the render's ([`PixelBuffers::set_depth_scale`], known before any sample,
+/// so the same whether the image is filtered whole or by bands), else over both halves of
+/// every pixel with a first hit that the buffers hold (the whole image but in a render by
+/// bands), whatever part of it is filtered.
 pub(crate) fn depth_scale(b: &PixelBuffers) -> f32 {
+    if let Some(s) = b.depth_scale() {
+        return s;
+    }
     let (mut dsum, mut dcount) = (0.0f64, 0u64);
     for p in b.half(0).iter().chain(b.half(1)) {
         let depth = p.features()[DEPTH];
@@ -211,8 +216,7 @@ impl Inputs {
         let w = b.size().0 as usize;
         let h = rows.len();
         let n = w * h;
-        let span = rows.start * w..rows.end * w;
-        let [a, bb] = [&b.half(0)[span.clone()], &b.half(1)[span]];
+        let [a, bb] = [b.rows_of(0, rows.clone()), b.rows_of(1, rows)];
         let mut inp = Inputs {
             color: [Planes::new(w, h, 3), Planes::new(w, h, 3)],
             color_var: [Planes::new(w, h, 3), Planes::new(w, h, 3)],

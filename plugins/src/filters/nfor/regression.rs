@@ -43,19 +43,22 @@ pub(crate) struct Regression<'a> {
     pub stride: usize,
 }
 
-/// The smallest rectangle within `tile` holding its pixels marked in `fit`; None if none is.
+/// The smallest rectangle within `tile` holding its pixels marked in `fit`, from the tile's
+/// first column; None if none is. The patch distances' running sums along a row start at
+/// the rectangle's first column: starting at the tile's, they come out the same whichever
+/// pixels are marked, so a band's fits are the whole image's, bit for bit (a pixel near a
+/// band's halo edge may take an own fit that it does not in the whole image).
 fn marked_box(tile: Rect, fit: &[bool], w: usize) -> Option<Rect> {
     let mut b: Option<Rect> = None;
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             if fit[y * w + x] {
                 let r = b.get_or_insert(Rect {
-                    x0: x,
+                    x0: tile.x0,
                     x1: x + 1,
                     y0: y,
                     y1: y + 1,
                 });
-                r.x0 = r.x0.min(x);
                 r.x1 = r.x1.max(x + 1);
                 r.y1 = y + 1;
             }

@@ -18,8 +18,20 @@ fn film(
         &BoxFilter::new(0.5, 0.5),
     );
     film.keep_pixel_buffers();
+    add_rows(&mut film, w, 0..h, spp, &sample);
+    film
+}
+
+/// Adds the samples of rows `rows` to `film`, as [`film`] does.
+fn add_rows(
+    film: &mut Film,
+    w: u32,
+    rows: Range<u32>,
+    spp: u32,
+    sample: impl Fn(u32, u32, u32) -> Option<([f32; 3], Features)>,
+) {
     let (mut batch, mut radiance, mut features) = (Vec::new(), Vec::new(), Vec::new());
-    for y in 0..h {
+    for y in rows {
         for x in 0..w {
             for i in 0..spp {
                 let Some((l, f)) = sample(x, y, i) else {
@@ -37,7 +49,6 @@ fn film(
         }
     }
     film.add_points(&batch, &radiance, Some(&features));
-    film
 }
 
 /// A wall: grey albedo, facing the camera, at depth 2.
@@ -158,13 +169,9 @@ fn a_splatting_film_gives_its_pixel_means() {
     assert_eq!(out[0], Spectrum::ZERO);
 }
 
-#[test]
-fn bands_give_the_whole_images_bytes() {
-    // Rows of different kinds (walls, a second surface, an emitter) and noise, tall enough
-    // for five bands of 32 rows with their halo: every pixel, its estimated error too, must
-    // come out as from the whole image at once.
-    let (w, h) = (24, 150);
-    let film = film(w, h, 4, |x, y, i| {
+/// Rows of different kinds (walls, a second surface, an emitter) and noise, `w` pixels wide.
+fn striped(w: u32) -> impl Fn(u32, u32, u32) -> Option<([f32; 3], Features)> {
+    move |x, y, i| {
         let v = hash(((y * w + x) << 3) + i) * if (x + y / 7) % 9 > 4 { 2.0 } else { 0.5 };
         match (y / 11) % 4 {
             0 => Some(([4.0, 4.0, 4.0], [0.0; 7])),
@@ -174,12 +181,22 @@ fn bands_give_the_whole_images_bytes() {
             )),
             _ => Some(([v, v, v * 2.0], WALL)),
         }
-    });
-    let bits = |v: &[Spectrum]| -> Vec<u32> {
-        v.iter()
-            .flat_map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
-            .collect()
-    };
+    }
+}
+
+/// Each channel's bits.
+fn bits(v: &[Spectrum]) -> Vec<u32> {
+    v.iter()
+        .flat_map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
+        .collect()
+}
+
+#[test]
+fn bands_give_the_whole_images_bytes() {
+    // Tall enough for five bands of 32 rows with their halo: every pixel, its estimated error
+    // too, must come out as from the whole image at once.
+    let (w, h) = (24, 150);
+    let film = film(w, h, 4, striped(w));
     // The default windows, with and without the second pass, and wider ones (a halo of two
     // tiles).
     let wider = || NforFilter::new(5, 2, 4, 2, RIDGE);
@@ -199,4 +216,52 @@ fn bands_give_the_whole_images_bytes() {
         let fb = |v: &[f32]| v.iter().map(|e| e.to_bits()).collect::<Vec<_>>();
         assert_eq!(fb(&ea), fb(&eb));
     }
+}
+
+#[test]
+fn a_film_that_holds_a_window_of_rows_gives_the_whole_images_bytes() {
+    // A render by bands: rows come in band by band, each band is made once its rows and halo
+    // are in, and the rows no later band reads are freed; the depth scale is set before.
+    let (w, h) = (24, 150);
+    for second in [true, false] {
+        let filter = NforFilter::default().with_second_pass(second).with_band(32);
+        let mut whole = film(w, h, 4, striped(w));
+        whole.set_depth_scale(0.25);
+        let expected = reconstruct(&filter.clone().with_band(0), &whole);
+        let plan = filter.bands(h as usize).expect("bands");
+        let mut film = Film::new(
+            FilmSettings::with_resolution(w, h),
+            &BoxFilter::new(0.5, 0.5),
+        );
+        film.keep_pixel_buffers();
+        film.set_depth_scale(0.25);
+        film.hold_rows(false, plan.rows + 2 * plan.halo);
+        let (mut got, mut rows_in) = (Vec::new(), 0);
+        let mut most_held = 0;
+        for band in plan.layout(h as usize) {
+            let read = plan.read(&band, h as usize);
+            add_rows(&mut film, w, rows_in as u32..read.end as u32, 4, striped(w));
+            rows_in = read.end;
+            let held = film.pixel_buffers().expect("buffers").held_rows();
+            most_held = most_held.max(held.len());
+            got.extend(filter.reconstruct_rows(&film, band.clone()));
+            film.release_rows(band.end.saturating_sub(plan.halo));
+        }
+        assert_eq!(bits(&got), bits(&expected), "second pass {second}");
+        assert!(most_held <= plan.rows + 2 * plan.halo, "{most_held}");
+        // Every pixel's count is kept, and no sums (nothing to merge).
+        film.release_rows(h as usize);
+        assert!(film.pixel_stats().iter().all(|s| s.count == 4));
+        assert!(film.weighted_sums().is_none());
+        // Without a depth scale set, the halves' own: another image.
+        let mut unscaled = film_of(w, h);
+        assert_ne!(bits(&reconstruct(&filter, &unscaled)), bits(&expected));
+        unscaled.set_depth_scale(0.25);
+        assert_eq!(bits(&reconstruct(&filter, &unscaled)), bits(&expected));
+    }
+}
+
+/// The striped film, whole.
+fn film_of(w: u32, h: u32) -> Film {
+    film(w, h, 4, striped(w))
 }
