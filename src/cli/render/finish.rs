@@ -7,7 +7,7 @@ use super::target::Target;
 use super::{Clock, RenderArgs, SamplerCost};
 use crate::cli::aov::write_aov;
 use crate::cli::output::{reached_spp, End};
-use crate::cli::stats::{peak_rss_mb, Seconds, Stats};
+use crate::cli::stats::{peak_rss_mb, ByPhase, Rss, Seconds, Stats};
 use crate::geometry::Spectrum;
 use crate::render::Halt;
 
@@ -114,6 +114,20 @@ pub(super) fn stats(
         sampler_share: cost.map(|c| c.share),
         sampler_cost_pairs: cost.map(|c| c.pairs),
         peak_rss_mb: peak_rss_mb(),
+        peak_rss_mb_by_phase: by_phase(clock, |r| r.peak),
+        rss_mb_by_phase: by_phase(clock, |r| r.held),
+    }
+}
+
+/// One figure of the resident memory at the end of each phase.
+fn by_phase(clock: &Clock, figure: fn(&Rss) -> f64) -> ByPhase {
+    let [parse, build, render, reconstruct, write] = clock.rss.each_ref().map(figure);
+    ByPhase {
+        parse,
+        build,
+        render,
+        reconstruct,
+        write,
     }
 }
 

@@ -3,6 +3,7 @@
 //! (`prepare.rs`, with `--pipeline`'s choice in `pipeline.rs`), plan the output files (`target.rs`), render (`run.rs`), measure the
 //! sampler's cost (`sampler_cost.rs`), write the image, the AOVs and the stats (`finish.rs`).
 
+use crate::cli::stats::Rss;
 use std::time::Instant;
 
 mod args;
@@ -37,6 +38,9 @@ struct Clock {
     reconstructed: Instant,
     /// The image and AOVs written.
     written: Instant,
+    /// The resident memory at the end of the parse, the build, the render (with
+    /// `--sampler-cost`'s measure), the reconstruction and the writing.
+    rss: [Rss; 5],
 }
 
 impl Clock {
@@ -51,6 +55,7 @@ impl Clock {
             measured: now,
             reconstructed: now,
             written: now,
+            rss: [Rss::default(); 5],
         }
     }
 
@@ -66,21 +71,26 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     prepare::start_threads(args.threads)?;
     let desc = prepare::read_scene(args)?;
     clock.parsed = Instant::now();
+    clock.rss[0] = Rss::now();
 
     let mut job = Job::prepare(args, desc)?;
     let target = Target::plan(args, &job)?;
     clock.built = Instant::now();
+    clock.rss[1] = Rss::now();
 
     let mut rendered = run::render_scene(args, &mut job, &target)?;
     clock.rendered = Instant::now();
     let cost = measure_sampler_cost(args, &job, &mut rendered)?;
     // The measure's renders are no part of the reconstruction.
     clock.measured = Instant::now();
+    clock.rss[2] = Rss::now();
 
     let image = job.plugins.image(&rendered.film);
     clock.reconstructed = Instant::now();
+    clock.rss[3] = Rss::now();
     finish::write_image_and_aovs(args, &job, &target, &mut rendered, &image, &clock)?;
     clock.written = Instant::now();
+    clock.rss[4] = Rss::now();
 
     let stats = finish::stats(args, &job, &rendered, cost, &clock);
     finish::write_stats(args, &stats)?;
