@@ -4,6 +4,7 @@
 //! sampler's cost (`sampler_cost.rs`), write the image, the AOVs and the stats (`finish.rs`).
 
 use crate::cli::stats::Rss;
+use acr_parser::SceneDescription;
 use std::time::Instant;
 
 mod args;
@@ -73,14 +74,19 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     clock.parsed = Instant::now();
     clock.rss[0] = Rss::now();
 
-    let mut job = Job::prepare(args, desc)?;
-    let target = Target::plan(args, &job)?;
+    let mut job = Job::prepare(args, &desc)?;
+    let target = Target::plan(args, &job, &desc)?;
+    // The render needs the built scene alone (`--sampler-cost` chooses its plugins again from
+    // the description): freed before the film is made, the description and the scene text
+    // are no part of the peak (docs/BENCHMARKS.md, memory on the interiors).
+    let desc = args.sampler_cost.then_some(desc);
+    prepare::return_freed_memory();
     clock.built = Instant::now();
     clock.rss[1] = Rss::now();
 
     let mut rendered = run::render_scene(args, &mut job, &target)?;
     clock.rendered = Instant::now();
-    let cost = measure_sampler_cost(args, &job, &mut rendered)?;
+    let cost = measure_sampler_cost(args, &job, desc.as_ref(), &mut rendered)?;
     // The measure's renders are no part of the reconstruction.
     clock.measured = Instant::now();
     clock.rss[2] = Rss::now();
@@ -102,13 +108,14 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
 fn measure_sampler_cost(
     args: &RenderArgs,
     job: &Job,
+    desc: Option<&SceneDescription>,
     rendered: &mut Rendered,
 ) -> Result<Option<SamplerCost>, String> {
-    let Some(batches) = rendered.batches.take() else {
+    let (Some(batches), Some(desc)) = (rendered.batches.take(), desc) else {
         return Ok(None);
     };
     let run = SamplerCostRun {
-        desc: &job.desc,
+        desc,
         scene: &job.scene,
         overrides: &job.overrides,
         args,
