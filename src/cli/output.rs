@@ -52,7 +52,7 @@ pub struct Output {
 pub fn scene_hash(desc: &acr_parser::SceneDescription) -> i32 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for f in &desc.files {
-        for &b in f.text.as_bytes() {
+        for &b in f.text().as_bytes() {
             h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
         }
     }

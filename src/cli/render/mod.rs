@@ -71,11 +71,17 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     let mut clock = Clock::start();
     prepare::start_threads(args.threads)?;
     let desc = prepare::read_scene(args)?;
+    let scene_hash = target::scene_hash_of(args, &desc);
+    // Nothing reads the text again but a diagnostic, which reads the file again: freed before
+    // the build, it is no part of the peak (docs/BENCHMARKS.md, memory on the interiors).
+    for f in &desc.files {
+        f.release_text();
+    }
     clock.parsed = Instant::now();
     clock.rss[0] = Rss::now();
 
     let mut job = Job::prepare(args, &desc)?;
-    let target = Target::plan(args, &job, &desc)?;
+    let target = Target::plan(args, &job, scene_hash)?;
     // The render needs the built scene alone (`--sampler-cost` chooses its plugins again from
     // the description): freed before the film is made, the description and the scene text
     // are no part of the peak (docs/BENCHMARKS.md, memory on the interiors).

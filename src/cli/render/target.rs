@@ -19,13 +19,9 @@ pub(super) struct Target {
 }
 
 impl Target {
-    /// The output and AOV files of `args` for `job` (parsed as `desc`), each checked to be
-    /// writable.
-    pub(super) fn plan(
-        args: &RenderArgs,
-        job: &Job,
-        desc: &SceneDescription,
-    ) -> Result<Target, String> {
+    /// The output and AOV files of `args` for `job`, each checked to be writable; an EXR
+    /// output carries `scene_hash` ([`scene_hash_of`]).
+    pub(super) fn plan(args: &RenderArgs, job: &Job, scene_hash: i32) -> Result<Target, String> {
         let output = output_path(args, job.scene.film.filename.as_deref());
         let is_exr = is_exr(&output);
         if args.mergeable && !is_exr {
@@ -44,14 +40,27 @@ impl Target {
             .flatten()
             .collect();
         let mut out = output_of(args, job, output, is_exr);
-        // Only an EXR carries the hash: a PNG or PFM render does not read the scene again.
         if is_exr {
-            out.scene = scene_hash(desc);
+            out.scene = scene_hash;
         }
         for a in &aovs {
             place_aov(a, &mut out, job, is_exr)?;
         }
         Ok(Target { out, aovs })
+    }
+}
+
+/// The hash of the scene's text (the files of `desc`) an EXR output carries, or 0 when the
+/// output is not an EXR: a PNG or PFM render does not read the scene again.
+pub(super) fn scene_hash_of(args: &RenderArgs, desc: &SceneDescription) -> i32 {
+    let film_name = desc
+        .film
+        .as_ref()
+        .and_then(|f| f.params.string("filename").ok().flatten());
+    if is_exr(&output_path(args, film_name)) {
+        scene_hash(desc)
+    } else {
+        0
     }
 }
 
