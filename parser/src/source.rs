@@ -442,6 +442,39 @@ mod tests {
     }
 
     #[test]
+    fn a_released_text_is_read_again_for_diagnostics_and_locations_do_not_change() {
+        let dir = temp_dir("release");
+        let path = dir.join("scene.pbrt");
+        let text = "# héllo\nShape \"sphère\" \"float radius\" [ -1 ]\n  é\nWorldEnd";
+        std::fs::write(&path, text).unwrap();
+        let file = SourceFile::read_from(&path, text.to_owned());
+        let before: Vec<_> = (0..=text.len())
+            .map(|o| (Loc::new(&file, o).line_col(), Loc::new(&file, o).snippet()))
+            .collect();
+        file.release_text();
+        assert!(
+            file.text.lock().unwrap().is_none(),
+            "the text is still held"
+        );
+        for (o, b) in before.iter().enumerate() {
+            let loc = Loc::new(&file, o);
+            assert_eq!(&(loc.line_col(), loc.snippet()), b, "at {o}");
+        }
+        assert_eq!(file.text().as_str(), text);
+        // A file changed since: no quote from the wrong text, nor a panic.
+        std::fs::write(&path, "WorldBegin\n").unwrap();
+        assert_eq!(file.text().as_str(), "");
+        // The line still comes from the index; a column on a non-ASCII line needs the text.
+        assert_eq!(Loc::new(&file, 12).line_col().0, 2);
+        let _ = Loc::new(&file, 12).snippet();
+        // A text given in memory has no file to read again: it is kept.
+        let kept = SourceFile::new(&path, "Shape");
+        kept.release_text();
+        assert_eq!(kept.text().as_str(), "Shape");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn the_line_index_gives_the_counted_line_and_column_everywhere() {
         let texts = [
             "",
