@@ -427,7 +427,7 @@ fn a_trianglemesh_keeps_its_arrays_once_in_its_mesh_and_the_dump_is_unchanged() 
             .collect::<Vec<_>>()
             .join(" ")
     };
-    let n = vec![0.0, 0.0, 1.0].repeat(9);
+    let n = [0.0, 0.0, 1.0].repeat(9);
     let text =
         format!(
         "WorldBegin\nShape \"trianglemesh\" \"point P\" [{}] \"normal N\" [{}] \"float uv\" [{}] \
