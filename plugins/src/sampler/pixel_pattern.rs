@@ -192,6 +192,10 @@ impl<T: PixelPattern> Sampler for T {
         true
     }
 
+    fn reads_film(&self) -> bool {
+        false
+    }
+
     fn whole_passes(&self) -> bool {
         true
     }
