@@ -38,6 +38,8 @@ pub struct Token {
 /// Splits one file's text into tokens, lazily.
 pub struct Tokenizer {
     file: Arc<SourceFile>,
+    /// The file's text, held while it is read.
+    text: Arc<String>,
     pos: usize,
 }
 
@@ -106,12 +108,9 @@ impl Tokenizer {
     /// A tokenizer at the start of `file`.
     pub fn new(file: Arc<SourceFile>) -> Self {
         // A UTF-8 byte order mark is not part of the scene.
-        let pos = if file.text.starts_with('\u{feff}') {
-            3
-        } else {
-            0
-        };
-        Self { file, pos }
+        let text = file.text();
+        let pos = if text.starts_with('\u{feff}') { 3 } else { 0 };
+        Self { file, text, pos }
     }
 
     /// The file being read.
@@ -125,7 +124,7 @@ impl Tokenizer {
 
     /// The next token, or `None` at the end of the file.
     pub fn next_token(&mut self) -> Result<Option<Token>> {
-        let text: &str = &self.file.text;
+        let text: &str = &self.text;
         let mut rest = &text[self.pos..];
         // Most tokens follow a single space: step over it before asking the general parser.
         if rest.as_bytes().first() == Some(&b' ') {

@@ -142,7 +142,12 @@ pub struct Param {
     /// Where its declaration starts.
     pub loc: Loc,
     used: AtomicBool,
+    /// How many values it had before [`Param::keep_head`] dropped all but the first.
+    full_len: Option<usize>,
 }
+
+/// How many values the scene dump shows of a long parameter.
+const SHOWN: usize = 12;
 
 impl Clone for Param {
     fn clone(&self) -> Self {
@@ -152,6 +157,7 @@ impl Clone for Param {
             values: self.values.clone(),
             loc: self.loc.clone(),
             used: AtomicBool::new(self.was_used()),
+            full_len: self.full_len,
         }
     }
 }
@@ -165,7 +171,31 @@ impl Param {
             values,
             loc,
             used: AtomicBool::new(false),
+            full_len: None,
         }
+    }
+
+    /// Drops all values but the first few that the scene dump shows, keeping their count, once
+    /// the values live elsewhere (a `trianglemesh`'s arrays, in its [`crate::Mesh`]): a long
+    /// mesh's numbers were held twice, as f64 here and as f32 there. Lookups then see the
+    /// first values alone.
+    pub fn keep_head(&mut self) {
+        let len = self.values.len();
+        if len <= SHOWN {
+            return;
+        }
+        fn head<T>(v: &mut Vec<T>) {
+            v.truncate(SHOWN);
+            v.shrink_to_fit();
+        }
+        match &mut self.values {
+            Values::Ints(v) => head(v),
+            Values::Floats(v) => head(v),
+            Values::Strings(v) => head(v),
+            Values::Bools(v) => head(v),
+            Values::Texture(_) => return,
+        }
+        self.full_len = Some(len);
     }
 
     /// Whether anything has looked this parameter up.
@@ -388,28 +418,29 @@ impl ParamList {
 impl fmt::Display for Param {
     /// `type name = values`, long arrays shortened, for the scene-graph dump.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        const SHOWN: usize = 12;
         write!(f, "{} {} = ", self.ty.name(), self.name)?;
         fn list<T>(
             f: &mut fmt::Formatter<'_>,
             v: &[T],
+            len: usize,
             show: impl Fn(&T) -> String,
         ) -> fmt::Result {
-            if v.len() == 1 {
+            if len == 1 {
                 return write!(f, "{}", show(&v[0]));
             }
             let items: Vec<String> = v.iter().take(SHOWN).map(show).collect();
             write!(f, "[{}", items.join(" "))?;
-            if v.len() > SHOWN {
-                write!(f, " ... ({} values)", v.len())?;
+            if len > SHOWN {
+                write!(f, " ... ({len} values)")?;
             }
             write!(f, "]")
         }
+        let len = self.full_len.unwrap_or(self.values.len());
         match &self.values {
-            Values::Ints(v) => list(f, v, |x| x.to_string()),
-            Values::Floats(v) => list(f, v, |x| crate::fmt_num(*x)),
-            Values::Strings(v) => list(f, v, |s| format!("{s:?}")),
-            Values::Bools(v) => list(f, v, |b| b.to_string()),
+            Values::Ints(v) => list(f, v, len, |x| x.to_string()),
+            Values::Floats(v) => list(f, v, len, |x| crate::fmt_num(*x)),
+            Values::Strings(v) => list(f, v, len, |s| format!("{s:?}")),
+            Values::Bools(v) => list(f, v, len, |b| b.to_string()),
             Values::Texture(t) => {
                 write!(f, "{:?}", t.name)?;
                 if let Some(i) = t.float {

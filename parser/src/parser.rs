@@ -60,7 +60,7 @@ pub const DIRECTIVES: &[&str] = &[
 /// Parses the scene file at `path` and every file it includes.
 pub fn parse_file(path: &Path) -> Result<SceneDescription> {
     let text = read_text(path)?;
-    parse_source(SourceFile::new(path, text))
+    parse_source(SourceFile::read_from(path, text))
 }
 
 /// Parses scene text as if it were the file at `path` (used for relative names and messages).
@@ -182,7 +182,7 @@ impl Parser {
 
     fn end_loc_of_main(&self) -> Loc {
         let file = self.builder.main_file();
-        Loc::new(file, file.text.len())
+        Loc::new(file, file.len())
     }
 
     fn directive(&mut self, name: &str, loc: Loc) -> Result<()> {
@@ -348,7 +348,7 @@ impl Parser {
                 )
             })?;
         let text = decode_text(&path, bytes)?;
-        let file = SourceFile::new(path, text);
+        let file = SourceFile::read_from(path, text);
         self.builder.add_file(Arc::clone(&file));
         self.stack.push(Tokenizer::new(file));
         Ok(())

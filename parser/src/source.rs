@@ -2,15 +2,21 @@
 
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
-/// One scene file's text, kept so that any later diagnostic can quote its line.
+/// One scene file's text, kept so that any later diagnostic can quote its line. Once the
+/// scene is parsed the text may be released ([`SourceFile::release_text`]): a diagnostic after
+/// that reads the file again.
 #[derive(Debug)]
 pub struct SourceFile {
     /// The path as the user (or the including file) named it.
     pub path: PathBuf,
-    /// The whole text of the file.
-    pub text: Arc<str>,
+    /// The whole text of the file, until released.
+    text: Mutex<Option<Arc<String>>>,
+    /// The text's length in bytes (a file read again must have it, or it changed).
+    len: usize,
+    /// Whether the text came from the file at `path` (and can be read again from there).
+    on_disk: bool,
     /// Where each line starts, built on the first location resolved: counting lines from the
     /// start of the file for every location printed was quadratic (`acr parse` of a 30 MB
     /// scene spent 98% of 18 to 97 s there).
@@ -53,17 +59,68 @@ impl LineIndex {
 }
 
 impl SourceFile {
-    /// Wraps a file's text under the given path.
-    pub fn new(path: impl Into<PathBuf>, text: impl Into<Arc<str>>) -> Arc<Self> {
+    /// Wraps a text under the given path (the text is its own: it cannot be released).
+    pub fn new(path: impl Into<PathBuf>, text: impl Into<String>) -> Arc<Self> {
+        Self::with_origin(path.into(), text.into(), false)
+    }
+
+    /// Wraps the text just read from the file at `path`: it can be released once parsed and
+    /// read again for a diagnostic.
+    pub fn read_from(path: impl Into<PathBuf>, text: String) -> Arc<Self> {
+        Self::with_origin(path.into(), text, true)
+    }
+
+    fn with_origin(path: PathBuf, text: String, on_disk: bool) -> Arc<Self> {
         Arc::new(Self {
-            path: path.into(),
-            text: text.into(),
+            path,
+            len: text.len(),
+            // An Arc of the String keeps its buffer: an `Arc<str>` would copy the whole file.
+            text: Mutex::new(Some(Arc::new(text))),
+            on_disk,
             lines: OnceLock::new(),
         })
     }
 
+    /// The file's text: the one parsed, or once released, the file read again (empty if it
+    /// cannot be read or its length changed).
+    pub fn text(&self) -> Arc<String> {
+        let kept = self.text.lock().map_or(None, |t| t.clone());
+        kept.unwrap_or_else(|| {
+            let again = read_file(&self.path, FileKind::Scene)
+                .ok()
+                .and_then(|bytes| String::from_utf8(bytes).ok())
+                .filter(|t| t.len() == self.len);
+            Arc::new(again.unwrap_or_default())
+        })
+    }
+
+    /// The text's length in bytes.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the text is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Frees the text of a file read from disk (its lines indexed first, so that locations
+    /// still resolve to line and column without it); a diagnostic that quotes a line reads
+    /// the file again. A text given in memory is kept.
+    pub fn release_text(&self) {
+        if !self.on_disk {
+            return;
+        }
+        if let Ok(mut t) = self.text.lock() {
+            if let Some(text) = t.as_ref() {
+                self.lines.get_or_init(|| LineIndex::new(text));
+            }
+            *t = None;
+        }
+    }
+
     fn lines(&self) -> &LineIndex {
-        self.lines.get_or_init(|| LineIndex::new(&self.text))
+        self.lines.get_or_init(|| LineIndex::new(&self.text()))
     }
 
     /// The directory holding this file, against which relative names inside it resolve.
@@ -95,15 +152,16 @@ impl Loc {
 
     /// 1-based line and column (in characters) of this location.
     pub fn line_col(&self) -> (usize, usize) {
-        let text = &self.file.text;
-        let offset = (self.offset as usize).min(text.len());
+        let offset = (self.offset as usize).min(self.file.len());
         let index = self.file.lines();
         let line = index.line_of(offset as u32);
         let start = index.starts[line] as usize;
         let col = if index.ascii[line] {
             offset - start
         } else {
-            String::from_utf8_lossy(&text.as_bytes()[start..offset])
+            let text = self.file.text();
+            let bytes = text.as_bytes();
+            String::from_utf8_lossy(&bytes[start.min(bytes.len())..offset.min(bytes.len())])
                 .chars()
                 .count()
         };
@@ -114,7 +172,7 @@ impl Loc {
     /// the column when very long (pbrt files often hold a whole mesh on one line).
     pub fn snippet(&self) -> String {
         const MAX: usize = 120;
-        let text = &self.file.text;
+        let text = self.file.text();
         let offset = (self.offset as usize).min(text.len());
         let bytes = text.as_bytes();
         let start = bytes[..offset]
@@ -380,6 +438,39 @@ mod tests {
         // Opening the pipe would wait for a writer forever.
         let e = read_file(&fifo, FileKind::Scene).unwrap_err();
         assert!(e.to_string().contains("device, pipe or socket"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_released_text_is_read_again_for_diagnostics_and_locations_do_not_change() {
+        let dir = temp_dir("release");
+        let path = dir.join("scene.pbrt");
+        let text = "# héllo\nShape \"sphère\" \"float radius\" [ -1 ]\n  é\nWorldEnd";
+        std::fs::write(&path, text).unwrap();
+        let file = SourceFile::read_from(&path, text.to_owned());
+        let before: Vec<_> = (0..=text.len())
+            .map(|o| (Loc::new(&file, o).line_col(), Loc::new(&file, o).snippet()))
+            .collect();
+        file.release_text();
+        assert!(
+            file.text.lock().unwrap().is_none(),
+            "the text is still held"
+        );
+        for (o, b) in before.iter().enumerate() {
+            let loc = Loc::new(&file, o);
+            assert_eq!(&(loc.line_col(), loc.snippet()), b, "at {o}");
+        }
+        assert_eq!(file.text().as_str(), text);
+        // A file changed since: no quote from the wrong text, nor a panic.
+        std::fs::write(&path, "WorldBegin\n").unwrap();
+        assert_eq!(file.text().as_str(), "");
+        // The line still comes from the index; a column on a non-ASCII line needs the text.
+        assert_eq!(Loc::new(&file, 12).line_col().0, 2);
+        let _ = Loc::new(&file, 12).snippet();
+        // A text given in memory has no file to read again: it is kept.
+        let kept = SourceFile::new(&path, "Shape");
+        kept.release_text();
+        assert_eq!(kept.text().as_str(), "Shape");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -401,3 +401,76 @@ fn garbage_never_panics() {
     // Most prefixes end inside a directive: the check above ran on their errors.
     assert!(errors > scene.len() / 2, "only {errors} errors");
 }
+
+#[test]
+fn a_trianglemesh_keeps_its_arrays_once_in_its_mesh_and_the_dump_is_unchanged() {
+    // A 3x3 grid of vertices: 9 positions, 8 triangles, normals and uvs, longer than the 12
+    // values the dump shows.
+    let mut p = Vec::new();
+    let mut uv = Vec::new();
+    for y in 0..3 {
+        for x in 0..3 {
+            p.extend([x as f64 * 0.1, y as f64 * 0.3, 0.7]);
+            uv.extend([x as f64 * 0.5, y as f64 * 0.5]);
+        }
+    }
+    let mut ix = Vec::new();
+    for y in 0..2 {
+        for x in 0..2 {
+            let v = y * 3 + x;
+            ix.extend([v, v + 1, v + 4, v, v + 4, v + 3]);
+        }
+    }
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let n = [0.0, 0.0, 1.0].repeat(9);
+    let text =
+        format!(
+        "WorldBegin\nShape \"trianglemesh\" \"point P\" [{}] \"normal N\" [{}] \"float uv\" [{}] \
+         \"integer indices\" [{}]\nWorldEnd\n",
+        join(&p),
+        join(&n),
+        join(&uv),
+        ix.iter().map(|i: &i32| i.to_string()).collect::<Vec<_>>().join(" ")
+    );
+    let d = parse(&text);
+    let shape = &d.shapes[0];
+    let mesh = shape.mesh.as_ref().expect("a mesh");
+    let p32: Vec<[f32; 3]> = p
+        .chunks(3)
+        .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+        .collect();
+    assert_eq!(mesh.positions, p32);
+    assert_eq!(
+        mesh.indices,
+        ix.iter().map(|&i| i as u32).collect::<Vec<_>>()
+    );
+    assert_eq!(mesh.normals.as_ref().map(Vec::len), Some(9));
+    assert_eq!(mesh.uvs.as_ref().map(Vec::len), Some(9));
+    // The parameters hold the first values alone, and print as the whole list did.
+    let params = &shape.plugin.params;
+    for (name, full) in [("P", p.len()), ("N", n.len()), ("uv", uv.len())] {
+        let param = params.get(name).unwrap();
+        assert_eq!(param.values.len(), 12, "{name}");
+        let shown = param.to_string();
+        assert!(
+            shown.ends_with(&format!(" ... ({full} values)]")),
+            "{shown}"
+        );
+    }
+    assert_eq!(
+        params.get("P").unwrap().to_string(),
+        "point3 P = [0 0 0.7 0.1 0 0.7 0.2 0 0.7 0 0.3 0.7 ... (27 values)]"
+    );
+    assert_eq!(params.get("indices").unwrap().values.len(), 12);
+    assert!(params
+        .get("indices")
+        .unwrap()
+        .to_string()
+        .ends_with("(24 values)]"));
+    assert_eq!(d.unused_parameter_warnings().len(), 0);
+}

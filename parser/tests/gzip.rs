@@ -39,7 +39,7 @@ fn a_gz_scene_and_its_gz_include_parse_as_their_text_and_errors_keep_file_line_c
         format!("{:?}", plain.shapes[0].plugin.params)
     );
     assert_eq!(gz.files.len(), 2);
-    assert_eq!(&*gz.files[1].text, inc);
+    assert_eq!(gz.files[1].text().as_str(), inc);
     // A misspelled directive in the compressed include: located in its decompressed text.
     std::fs::write(
         dir.join("inc.pbrt.gz"),

@@ -289,7 +289,7 @@ impl Setting {
     /// the plugin declares it: an unknown name or a value of the wrong type is an error.
     pub fn apply(&self, info: &PluginInfo, choice: &mut Choice) -> Result<()> {
         let name_loc = Loc::new(&self.source, self.kind.name().len() + 1);
-        let value_loc = Loc::new(&self.source, self.source.text.len() - self.value.len());
+        let value_loc = Loc::new(&self.source, self.source.len() - self.value.len());
         let spec = info
             .params
             .iter()

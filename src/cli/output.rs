@@ -52,7 +52,7 @@ pub struct Output {
 pub fn scene_hash(desc: &acr_parser::SceneDescription) -> i32 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for f in &desc.files {
-        for &b in f.text.as_bytes() {
+        for &b in f.text().as_bytes() {
             h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
         }
     }
@@ -71,7 +71,8 @@ impl Output {
         let sums = film
             .weighted_sums()
             .ok_or("the film has no sums to merge")?;
-        let stats = film.pixel_stats();
+        // A film that counts its pixels' samples alone has no moments to write.
+        let stats = film.keeps_moments().then(|| film.pixel_stats());
         Ok(Sums {
             frame: self.frame,
             width: self.size.0,
@@ -80,8 +81,8 @@ impl Output {
                 .iter()
                 .map(|s| [s[0] * scale, s[1] * scale, s[2] * scale, s[3]])
                 .collect(),
-            counts: stats.iter().map(|p| f64::from(p.count)).collect(),
-            moments: Some(
+            counts: film.pixel_counts().iter().map(|&n| f64::from(n)).collect(),
+            moments: stats.map(|stats| {
                 stats
                     .iter()
                     .map(|p| {
@@ -96,8 +97,8 @@ impl Output {
                             q[2] * s2,
                         ]
                     })
-                    .collect(),
-            ),
+                    .collect()
+            }),
             aovs: Vec::new(),
             spp,
             offset: Some(self.offset),
@@ -121,7 +122,7 @@ impl Output {
     /// The image so far, mid-render: a mergeable EXR of the passes done when the sums can be
     /// merged (samplesPerPixel: the fewest samples any pixel has), else the splatted image.
     pub fn write_partial(&self, film: &Film, seconds: f64) -> Result<(), String> {
-        let spp = reached_spp(&film.pixel_stats());
+        let spp = reached_spp(&film.pixel_counts());
         if self.can_merge {
             let sums = self.sums(film, spp, seconds)?;
             return self.atomically(|temp| sums.write(temp));
@@ -144,16 +145,16 @@ impl Output {
     /// mergeable when asked or when the render was stopped by a signal and can be merged.
     /// `spp` is what each pixel was planned to get; a halted render records what it reached.
     pub fn write_final(&self, image: &[Spectrum], film: &Film, end: &End) -> Result<(), String> {
-        // Computed once, and only when read: with half buffers every call makes the whole
-        // image's statistics.
-        let stats = (end.halted || !self.channel_aovs.is_empty()).then(|| film.pixel_stats());
-        let stats = stats.as_deref().unwrap_or_default();
         let mut aovs = Vec::new();
-        for name in &self.channel_aovs {
-            aovs.extend(channel_values(name, stats, self.scale, end.features)?);
+        if !self.channel_aovs.is_empty() {
+            // Computed once: with half buffers every call makes the whole image's statistics.
+            let stats = film.pixel_stats();
+            for name in &self.channel_aovs {
+                aovs.extend(channel_values(name, &stats, self.scale, end.features)?);
+            }
         }
         let spp = if end.halted {
-            reached_spp(stats)
+            reached_spp(&film.pixel_counts())
         } else {
             end.spp
         };
@@ -238,8 +239,8 @@ pub struct End<'a> {
 }
 
 /// The samples every pixel has: the fewest any pixel has.
-pub fn reached_spp(stats: &[PixelStats]) -> u32 {
-    stats.iter().map(|p| p.count).min().unwrap_or(0)
+pub fn reached_spp(counts: &[u32]) -> u32 {
+    counts.iter().copied().min().unwrap_or(0)
 }
 
 /// The channels of AOV `name`, by [`CHANNEL_AOVS`]'s names (the variance in the units of the

@@ -90,6 +90,56 @@ pub struct Stats {
     pub mrays_per_s: f64,
     /// Peak resident memory in MiB.
     pub peak_rss_mb: f64,
+    /// The peak resident memory so far (MiB) when each phase ended: the first phase that
+    /// reaches `peak_rss_mb` holds the peak.
+    pub peak_rss_mb_by_phase: ByPhase,
+    /// The resident memory (MiB) held when each phase ended.
+    pub rss_mb_by_phase: ByPhase,
+}
+
+/// A figure at the end of each phase of a render.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct ByPhase {
+    /// Reading and parsing the scene files.
+    pub parse: f64,
+    /// Building the scene.
+    pub build: f64,
+    /// The render loop (and `--sampler-cost`'s measure).
+    pub render: f64,
+    /// Reconstructing the image.
+    pub reconstruct: f64,
+    /// Writing the output files.
+    pub write: f64,
+}
+
+/// The process's resident memory at one moment, in MiB.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Rss {
+    /// The peak so far (Linux: VmHWM).
+    pub peak: f64,
+    /// What is resident now (Linux: VmRSS).
+    pub held: f64,
+}
+
+impl Rss {
+    /// Now; zeros where unknown.
+    pub fn now() -> Self {
+        let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+        Self {
+            peak: status_mb(&status, "VmHWM:"),
+            held: status_mb(&status, "VmRSS:"),
+        }
+    }
+}
+
+/// The figure of `key` in `/proc/self/status`'s text, from kB to MiB; 0 where absent.
+fn status_mb(status: &str, key: &str) -> f64 {
+    status
+        .lines()
+        .find(|l| l.starts_with(key))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|kb| kb.parse::<f64>().ok())
+        .map_or(0.0, |kb| kb / 1024.0)
 }
 
 /// The median of `v` (the mean of the middle two for an even count); NaN when empty. Sorts
@@ -106,15 +156,7 @@ pub fn median(v: &mut [f64]) -> f64 {
 
 /// Peak resident set size of this process in MiB (Linux: VmHWM), or 0 where unknown.
 pub fn peak_rss_mb() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<f64>().ok())
-        })
-        .map_or(0.0, |kb| kb / 1024.0)
+    Rss::now().peak
 }
 
 #[cfg(test)]

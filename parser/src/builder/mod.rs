@@ -321,7 +321,16 @@ impl Builder {
 
     fn shape(&mut self, mut plugin: PluginDesc) -> Result<()> {
         let mesh = match plugin.kind.as_str() {
-            "trianglemesh" => Some(Arc::new(triangle_mesh(&plugin)?)),
+            "trianglemesh" => {
+                let mesh = triangle_mesh(&plugin)?;
+                // The arrays live in the mesh now: the parameters keep what the dump shows.
+                for p in plugin.params.iter_mut() {
+                    if matches!(p.name.as_str(), "P" | "N" | "uv" | "st" | "indices") {
+                        p.keep_head();
+                    }
+                }
+                Some(Arc::new(mesh))
+            }
             "plymesh" => Some(self.ply_mesh(&plugin)?),
             _ => None,
         };

@@ -57,6 +57,15 @@ impl PixelStats {
         }
     }
 
+    /// The statistics of `count` samples whose values were not kept (a film that counts its
+    /// pixels' samples alone, [`crate::Film::count_only`]): mean and deviations zero.
+    pub fn counted(count: u32) -> Self {
+        Self {
+            count,
+            ..Self::default()
+        }
+    }
+
     /// The mean radiance (zero without samples).
     pub fn mean(&self) -> Spectrum {
         Spectrum::from_array(self.mean)

@@ -149,6 +149,62 @@ fn batch_adding_equals_one_by_one() {
     assert_eq!(batch.pixel_stats()[0].count, 3);
 }
 
+/// A film that counts its pixels' samples alone makes the same image and counts as one that
+/// keeps their statistics, batch by batch or one by one, within a crop; only the moments are
+/// gone (zero).
+#[test]
+fn a_film_that_counts_only_makes_the_same_image_and_counts() {
+    use crate::filters::MitchellFilter;
+    let kernel = MitchellFilter::new(2.0, 1.5, 1.0 / 3.0, 1.0 / 3.0);
+    let mut s = FilmSettings::with_resolution(9, 7);
+    s.crop = [1, 8, 1, 6];
+    let mut full = Film::new(s.clone(), &kernel);
+    let mut counted = Film::new(s.clone(), &kernel);
+    let mut one_by_one = Film::new(s, &kernel);
+    counted.count_only();
+    one_by_one.count_only();
+    assert!(full.keeps_moments() && !counted.keeps_moments());
+    let mut samples = Vec::new();
+    for py in 0..7u32 {
+        for px in 0..9u32 {
+            for k in 0..1 + (px + py) % 3 {
+                let u = Vec2::new((k as f32 * 0.37 + 0.1) % 1.0, (k as f32 * 0.61 + 0.2) % 1.0);
+                let l = Spectrum::new(px as f32, py as f32 + 0.5, k as f32 + 1.0);
+                samples.push((Vec2::new(px as f32, py as f32) + u, l));
+            }
+        }
+    }
+    full.add_samples(&samples[..50]);
+    full.add_samples(&samples[50..]);
+    counted.add_samples(&samples[..50]);
+    counted.add_samples(&samples[50..]);
+    for &(p, l) in &samples {
+        one_by_one.add_sample(p, l);
+    }
+    assert_eq!(full.pixels(), counted.pixels());
+    assert_eq!(full.weighted_sums(), counted.weighted_sums());
+    assert_eq!(full.pixel_counts(), counted.pixel_counts());
+    assert_eq!(counted.pixel_counts(), one_by_one.pixel_counts());
+    let counts: Vec<u32> = full.pixel_stats().iter().map(|p| p.count).collect();
+    assert_eq!(&counts[..], &counted.pixel_counts()[..]);
+    assert!(counts.iter().any(|&n| n > 1), "{counts:?}");
+    let stats = counted.pixel_stats();
+    assert!(stats.iter().zip(&counts).all(|(p, &n)| p.count == n
+        && p.mean() == Spectrum::ZERO
+        && p.variance_of_mean() == Spectrum::ZERO));
+    // Split into two streams, each stream's film keeps its statistics again.
+    let mut split = Film::new(
+        FilmSettings::with_resolution(2, 1),
+        &BoxFilter::new(0.5, 0.5),
+    );
+    split.count_only();
+    split.split_streams(0.5);
+    assert!(split.keeps_moments());
+    split.add_stream_samples(0, &[(Vec2::new(0.5, 0.5), Spectrum::splat(2.0))]);
+    split.add_stream_samples(1, &[(Vec2::new(0.5, 0.5), Spectrum::splat(4.0))]);
+    assert_eq!(split.pixel_stats()[0].mean(), Spectrum::splat(3.0));
+}
+
 #[test]
 fn wide_filter_reaches_neighbours_and_crop_limits_output() {
     let mut s = FilmSettings::with_resolution(4, 4);

@@ -65,6 +65,14 @@ pub trait Filter: Send + Sync {
         false
     }
 
+    /// Whether the reconstruction reads the means or deviations of the pixels' own samples
+    /// ([`Film::pixel_stats`]) after a sampler that does not read the film
+    /// ([`crate::Sampler::reads_film`]); one that does not lets the film count them only
+    /// ([`Film::count_only`]). By default, it may.
+    fn reads_pixel_stats(&self) -> bool {
+        true
+    }
+
     /// What the last reconstruction reports for the stats file (nothing, for a splatting
     /// filter).
     fn report(&self) -> FilterReport {
@@ -136,6 +144,11 @@ impl<K: FilterKernel> Filter for Splatting<K> {
 
     fn kernel(&self) -> &dyn FilterKernel {
         &self.kernel
+    }
+
+    fn reads_pixel_stats(&self) -> bool {
+        // Only after an adaptive sampler, which reads the film itself.
+        false
     }
 
     fn reconstruct(&self, film: &Film, from: SamplerOutput<'_>) -> Vec<Spectrum> {

@@ -118,6 +118,13 @@ pub trait Sampler: Send {
         false
     }
 
+    /// Whether it reads the film, or makes or hands over anything that does (an error map, a
+    /// partition, cells, its own image): a sampler that does not lets the film count the
+    /// pixels' samples alone ([`crate::Film::count_only`]). By default, it may.
+    fn reads_film(&self) -> bool {
+        true
+    }
+
     /// The reconstruction's estimated squared error of each pixel from the film as it stands
     /// (or the variance of each pixel's mean where the filter makes no estimate), which it
     /// asked for ([`Sampler::wants_guidance`]). By default, ignored.

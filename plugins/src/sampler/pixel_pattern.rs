@@ -252,6 +252,10 @@ impl<T: PixelPattern> Sampler for T {
         true
     }
 
+    fn reads_film(&self) -> bool {
+        false
+    }
+
     fn whole_passes(&self) -> bool {
         true
     }

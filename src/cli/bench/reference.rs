@@ -27,13 +27,13 @@ fn reference_key(
     let desc = acr_parser::parse_file(scene).map_err(|e| e.to_string())?;
     let mut h = 0xcbf2_9ce4_8422_2325u64;
     for f in &desc.files {
-        fnv1a(&mut h, f.text.as_bytes());
+        fnv1a(&mut h, f.text().as_bytes());
         fnv1a(&mut h, &[0xff]);
     }
     // Meshes and images the scene loads are files too; their bytes count when present.
     let dir = scene.parent().unwrap_or(Path::new("."));
     for f in &desc.files {
-        for word in f.text.split('"') {
+        for word in f.text().split('"') {
             let lower = word.to_ascii_lowercase();
             if [".ply", ".exr", ".png", ".pfm", ".hdr"]
                 .iter()
@@ -146,7 +146,7 @@ mod tests {
             // The key as computed before the rule: the files, then the method string.
             let mut old = 0xcbf2_9ce4_8422_2325u64;
             for f in &desc.files {
-                fnv1a(&mut old, f.text.as_bytes());
+                fnv1a(&mut old, f.text().as_bytes());
                 fnv1a(&mut old, &[0xff]);
             }
             let m = format!(

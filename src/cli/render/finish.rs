@@ -7,7 +7,7 @@ use super::target::Target;
 use super::{Clock, RenderArgs, SamplerCost};
 use crate::cli::aov::write_aov;
 use crate::cli::output::{reached_spp, End};
-use crate::cli::stats::{peak_rss_mb, Seconds, Stats};
+use crate::cli::stats::{peak_rss_mb, ByPhase, Rss, Seconds, Stats};
 use crate::geometry::Spectrum;
 use crate::render::Halt;
 
@@ -117,6 +117,20 @@ pub(super) fn stats(
         sampler_share: cost.map(|c| c.share),
         sampler_cost_pairs: cost.map(|c| c.pairs),
         peak_rss_mb: peak_rss_mb(),
+        peak_rss_mb_by_phase: by_phase(clock, |r| r.peak),
+        rss_mb_by_phase: by_phase(clock, |r| r.held),
+    }
+}
+
+/// One figure of the resident memory at the end of each phase.
+fn by_phase(clock: &Clock, figure: fn(&Rss) -> f64) -> ByPhase {
+    let [parse, build, render, reconstruct, write] = clock.rss.each_ref().map(figure);
+    ByPhase {
+        parse,
+        build,
+        render,
+        reconstruct,
+        write,
     }
 }
 
@@ -179,7 +193,7 @@ pub(super) fn report_end(
 /// The mutations per pixel an mlt render made (its film holds splats, no samples); `None`
 /// for a render whose film holds its samples.
 fn mutations_made(rendered: &Rendered, pixels: usize) -> Option<u32> {
-    let splats_only = rendered.film.pixel_stats().iter().all(|p| p.count == 0);
+    let splats_only = rendered.film.pixel_counts().iter().all(|&n| n == 0);
     (splats_only && rendered.counts.samples > 0)
         .then(|| (rendered.counts.samples / pixels.max(1) as u64).min(u64::from(u32::MAX)) as u32)
 }
@@ -188,13 +202,13 @@ fn mutations_made(rendered: &Rendered, pixels: usize) -> Option<u32> {
 /// how to finish it.
 fn interrupted(args: &RenderArgs, target: &Target, rendered: &Rendered) -> String {
     let spp = rendered.spp;
-    let stats = rendered.film.pixel_stats();
+    let counts = rendered.film.pixel_counts();
     // sppm's image is not made of filtered samples: its camera samples count its iterations.
-    let pixels = stats.len().max(1) as u64;
+    let pixels = counts.len().max(1) as u64;
     let sppm_iterations = (rendered.counts.samples / pixels).min(u64::from(u32::MAX)) as u32;
-    let reached = match mutations_made(rendered, stats.len()) {
+    let reached = match mutations_made(rendered, counts.len()) {
         Some(m) => m,
-        None => reached_spp(&stats).max(sppm_iterations),
+        None => reached_spp(&counts).max(sppm_iterations),
     };
     let resume = if target.out.can_merge {
         // The rest's default footprint is this render's unless the command line chose one.

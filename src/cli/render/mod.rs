@@ -3,6 +3,8 @@
 //! (`prepare.rs`, with `--pipeline`'s choice in `pipeline.rs`), plan the output files (`target.rs`), render (`run.rs`), measure the
 //! sampler's cost (`sampler_cost.rs`), write the image, the AOVs and the stats (`finish.rs`).
 
+use crate::cli::stats::Rss;
+use acr_parser::SceneDescription;
 use std::time::Instant;
 
 mod args;
@@ -37,6 +39,9 @@ struct Clock {
     reconstructed: Instant,
     /// The image and AOVs written.
     written: Instant,
+    /// The resident memory at the end of the parse, the build, the render (with
+    /// `--sampler-cost`'s measure), the reconstruction and the writing.
+    rss: [Rss; 5],
 }
 
 impl Clock {
@@ -51,6 +56,7 @@ impl Clock {
             measured: now,
             reconstructed: now,
             written: now,
+            rss: [Rss::default(); 5],
         }
     }
 
@@ -65,17 +71,31 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
     let mut clock = Clock::start();
     prepare::start_threads(args.threads)?;
     let desc = prepare::read_scene(args)?;
+    let scene_hash = target::scene_hash_of(args, &desc);
+    // Nothing reads the text again but a diagnostic, which reads the file again: freed before
+    // the build, it is no part of the peak (docs/BENCHMARKS.md, memory on the interiors).
+    for f in &desc.files {
+        f.release_text();
+    }
     clock.parsed = Instant::now();
+    clock.rss[0] = Rss::now();
 
-    let mut job = Job::prepare(args, desc)?;
-    let target = Target::plan(args, &job)?;
+    let mut job = Job::prepare(args, &desc)?;
+    let target = Target::plan(args, &job, scene_hash)?;
+    // The render needs the built scene alone (`--sampler-cost` chooses its plugins again from
+    // the description): freed before the film is made, the description and the scene text
+    // are no part of the peak (docs/BENCHMARKS.md, memory on the interiors).
+    let desc = args.sampler_cost.then_some(desc);
+    prepare::return_freed_memory();
     clock.built = Instant::now();
+    clock.rss[1] = Rss::now();
 
     let mut rendered = run::render_scene(args, &mut job, &target)?;
     clock.rendered = Instant::now();
-    let cost = measure_sampler_cost(args, &job, &mut rendered)?;
+    let cost = measure_sampler_cost(args, &job, desc.as_ref(), &mut rendered)?;
     // The measure's renders are no part of the reconstruction.
     clock.measured = Instant::now();
+    clock.rss[2] = Rss::now();
 
     let image = match rendered.banded.as_mut() {
         // A render by bands made its image as it went.
@@ -85,8 +105,10 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
         None => job.plugins.image(&rendered.film),
     };
     clock.reconstructed = Instant::now();
+    clock.rss[3] = Rss::now();
     finish::write_image_and_aovs(args, &job, &target, &mut rendered, &image, &clock)?;
     clock.written = Instant::now();
+    clock.rss[4] = Rss::now();
 
     let stats = finish::stats(args, &job, &rendered, cost, &clock);
     finish::write_stats(args, &stats)?;
@@ -98,13 +120,14 @@ pub fn command(args: &RenderArgs) -> Result<(), String> {
 fn measure_sampler_cost(
     args: &RenderArgs,
     job: &Job,
+    desc: Option<&SceneDescription>,
     rendered: &mut Rendered,
 ) -> Result<Option<SamplerCost>, String> {
-    let Some(batches) = rendered.batches.take() else {
+    let (Some(batches), Some(desc)) = (rendered.batches.take(), desc) else {
         return Ok(None);
     };
     let run = SamplerCostRun {
-        desc: &job.desc,
+        desc,
         scene: &job.scene,
         overrides: &job.overrides,
         args,

@@ -20,6 +20,17 @@ pub(super) fn start_threads(threads: Option<u32>) -> Result<(), String> {
     Ok(())
 }
 
+/// Hands the pages of freed small blocks back to the system (glibc keeps them, inside its
+/// heap, for later allocations): once the scene description is freed, the render's film
+/// would otherwise come on top of its resident remains.
+pub(super) fn return_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free pages of the allocator's arenas to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 /// The scene file parsed, at a quarter of its resolution under `--quick`.
 pub(super) fn read_scene(args: &RenderArgs) -> Result<SceneDescription, String> {
     let mut desc = acr_parser::parse_file(&args.scene).map_err(|e| e.to_string())?;
@@ -31,8 +42,6 @@ pub(super) fn read_scene(args: &RenderArgs) -> Result<SceneDescription, String> 
 
 /// What is rendered: the scene and the plugins chosen for it.
 pub(super) struct Job {
-    /// The scene as parsed.
-    pub(super) desc: SceneDescription,
     /// The scene built.
     pub(super) scene: Scene,
     /// The command line's choices of plugins and their parameters (with an auto pipeline's).
@@ -54,20 +63,19 @@ pub(super) struct Job {
 impl Job {
     /// Builds the scene with the command line's crop, chooses its plugins, checks them against
     /// `--sample-offset` and `--mergeable`, and prints the warnings.
-    pub(super) fn prepare(args: &RenderArgs, desc: SceneDescription) -> Result<Job, String> {
+    pub(super) fn prepare(args: &RenderArgs, desc: &SceneDescription) -> Result<Job, String> {
         let spp = if args.quick { Some(1) } else { args.spp };
         let mut warnings = desc.warnings.clone();
-        let mut scene = build_scene(args, &desc, &mut warnings)?;
+        let mut scene = build_scene(args, desc, &mut warnings)?;
         let (w, h) = scene.film.size();
         let pixels = u64::from(w) * u64::from(h);
         // The pool is started ([`start_threads`]): its size is the render's.
         let threads = rayon::current_num_threads() as u32;
-        let auto = pipeline::choose(args, &desc, scene.dims, pixels, threads)?;
+        let auto = pipeline::choose(args, desc, scene.dims, pixels, threads)?;
         let reserve = pipeline::reserve(auto, pixels, threads);
         let overrides = overrides(args, auto)?;
-        let mut plugins =
-            choose_for_scene(&desc, &scene, &overrides, spp, args.seed, &mut warnings)
-                .map_err(|e| e.to_string())?;
+        let mut plugins = choose_for_scene(desc, &scene, &overrides, spp, args.seed, &mut warnings)
+            .map_err(|e| e.to_string())?;
         if matches!(plugins.integrator, Integrator::Sppm(_)) {
             let threshold = args.noise_threshold.is_some();
             if let Some(why) = sppm::refuse(plugins.sampler.as_ref(), threshold) {
@@ -92,12 +100,11 @@ impl Job {
             ));
         }
         let by_bands = by_bands(args, &mut plugins, scene.film.size().1);
-        print_warnings(&desc, warnings);
+        print_warnings(desc, warnings);
         if let Some(row) = auto {
             eprintln!("{}", pipeline::announce(row));
         }
         Ok(Job {
-            desc,
             scene,
             overrides,
             pipeline: auto,

@@ -59,6 +59,9 @@ pub(super) fn render_scene(
     let mut film = job
         .plugins
         .film_by_rows(&job.scene, window.map(|w| (w, keep_stats)));
+    if counts_suffice(args, job, target) {
+        film.count_only();
+    }
     let bar = progress_bar(args.quiet);
     let spp = match &job.plugins.integrator {
         // What mlt's --spp sets.
@@ -151,6 +154,24 @@ pub(super) fn render_scene(
         spp,
         banded,
     })
+}
+
+/// Whether nothing in this render reads the means or deviations of the pixels' own samples,
+/// so that the film may count them alone (4 bytes a pixel, not 28; docs/BENCHMARKS.md,
+/// memory on the interiors): no AOV, noise threshold, mergeable or
+/// partial file, sampler-cost measure, a sampler and a reconstruction that read none, and one
+/// sample stream.
+fn counts_suffice(args: &RenderArgs, job: &Job, target: &Target) -> bool {
+    let plugins = &job.plugins;
+    target.aovs.is_empty()
+        && args.noise_threshold.is_none()
+        && !args.mergeable
+        && args.write_partial_images.is_none()
+        && !args.sampler_cost
+        && job.splats
+        && plugins.sampler.streams() == 1
+        && !plugins.sampler.reads_film()
+        && !plugins.filter.reads_pixel_stats()
 }
 
 /// The options mlt cannot honour: it drives its own sampling (Markov chains), keeps no

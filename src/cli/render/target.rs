@@ -7,6 +7,7 @@ use super::RenderArgs;
 use crate::cli::aov::{parse_aovs, AovRequest};
 use crate::cli::output::{scene_hash, Output, CHANNEL_AOVS};
 use crate::image_io::{is_exr, Frame};
+use acr_parser::SceneDescription;
 use std::path::{Path, PathBuf};
 
 /// Where a render's image and AOVs go.
@@ -18,8 +19,9 @@ pub(super) struct Target {
 }
 
 impl Target {
-    /// The output and AOV files of `args` for `job`, each checked to be writable.
-    pub(super) fn plan(args: &RenderArgs, job: &Job) -> Result<Target, String> {
+    /// The output and AOV files of `args` for `job`, each checked to be writable; an EXR
+    /// output carries `scene_hash` ([`scene_hash_of`]).
+    pub(super) fn plan(args: &RenderArgs, job: &Job, scene_hash: i32) -> Result<Target, String> {
         let output = output_path(args, job.scene.film.filename.as_deref());
         let is_exr = is_exr(&output);
         if args.mergeable && !is_exr {
@@ -38,10 +40,27 @@ impl Target {
             .flatten()
             .collect();
         let mut out = output_of(args, job, output, is_exr);
+        if is_exr {
+            out.scene = scene_hash;
+        }
         for a in &aovs {
             place_aov(a, &mut out, job, is_exr)?;
         }
         Ok(Target { out, aovs })
+    }
+}
+
+/// The hash of the scene's text (the files of `desc`) an EXR output carries, or 0 when the
+/// output is not an EXR: a PNG or PFM render does not read the scene again.
+pub(super) fn scene_hash_of(args: &RenderArgs, desc: &SceneDescription) -> i32 {
+    let film_name = desc
+        .film
+        .as_ref()
+        .and_then(|f| f.params.string("filename").ok().flatten());
+    if is_exr(&output_path(args, film_name)) {
+        scene_hash(desc)
+    } else {
+        0
     }
 }
 
@@ -74,8 +93,8 @@ fn output_of(args: &RenderArgs, job: &Job, path: PathBuf, is_exr: bool) -> Outpu
             ),
         offset: args.sample_offset,
         channel_aovs: Vec::new(),
-        // Only an EXR carries the hash: a PNG or PFM render does not read the scene again.
-        scene: if is_exr { scene_hash(&job.desc) } else { 0 },
+        // Set by the caller, which has the description.
+        scene: 0,
         footprint: job
             .scene
             .uses_differentials
