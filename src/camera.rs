@@ -66,6 +66,9 @@ pub struct Camera {
     /// The inverse of `world_from_camera` when the camera does not move (computed once:
     /// light tracing maps every connection to the film through it).
     camera_from_world: Option<Mat4>,
+    /// The unit viewing direction in world space when the camera does not move (importance's
+    /// cosine, asked for at every connection).
+    forward: Option<Vec3>,
     /// Thin-lens radius; 0 for a pinhole.
     pub lens_radius: f32,
     /// Distance to the plane in focus.
@@ -195,6 +198,12 @@ impl Camera {
         let world_from_camera = MotionTransform::new(&inverse_motion);
         let camera_from_world =
             (!world_from_camera.is_moving()).then(|| world_from_camera.at(0.0).inverse());
+        let forward = (!world_from_camera.is_moving()).then(|| {
+            world_from_camera
+                .at(0.0)
+                .transform_vector3(Vec3::Z)
+                .normalize()
+        });
         Ok(Self {
             projection,
             resolution: (xres, yres),
@@ -202,6 +211,7 @@ impl Camera {
             camera_to_raster: raster_to_camera.inverse(),
             world_from_camera,
             camera_from_world,
+            forward,
             lens_radius,
             focal_distance,
             shutter_open,

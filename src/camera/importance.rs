@@ -53,8 +53,14 @@ impl Camera {
         if self.projection != Projection::Perspective {
             return None;
         }
-        let m = self.world_from_camera.at(time);
-        let cos = d.dot(m.transform_vector3(Vec3::Z).normalize());
+        let (forward, camera_from_world) = match (self.forward, self.camera_from_world) {
+            (Some(f), Some(c)) => (f, c),
+            _ => {
+                let m = self.world_from_camera.at(time);
+                (m.transform_vector3(Vec3::Z).normalize(), m.inverse())
+            }
+        };
+        let cos = d.dot(forward);
         if cos <= 0.0 {
             return None;
         }
@@ -64,7 +70,6 @@ impl Camera {
             } else {
                 1.0
             }) / cos);
-        let camera_from_world = self.camera_from_world.unwrap_or_else(|| m.inverse());
         let pc = camera_from_world.transform_point3(focus);
         let pr = self.camera_to_raster * pc.extend(1.0);
         let r = Vec2::new(pr.x / pr.w, pr.y / pr.w);
@@ -104,7 +109,9 @@ impl Camera {
         let m = self.world_from_camera.at(time);
         let lens = self.lens_radius * concentric_sample_disk(u);
         let q = m.transform_point3(Vec3::new(lens.x, lens.y, 0.0));
-        let n = m.transform_vector3(Vec3::Z).normalize();
+        let n = self
+            .forward
+            .unwrap_or_else(|| m.transform_vector3(Vec3::Z).normalize());
         let w = q - p;
         let dist = w.length();
         if dist == 0.0 {

@@ -148,6 +148,14 @@ impl Material {
         b
     }
 
+    /// [`Material::bsdf`] written into `b` (whatever it held): bdpt's vertices keep their
+    /// BSDFs from path to path and refill them in place.
+    #[inline]
+    pub fn bsdf_into(&self, si: &SurfaceInteraction, b: &mut Bsdf) {
+        b.reset(si, 1.0);
+        self.add_lobes(si, true, b, Spectrum::ONE, true);
+    }
+
     /// Adds this material's lobes to `b`, each weighted by `scale`; `first` (the material that
     /// owns the BSDF, as pbrt-v3's mix keeps its first material's) sets the relative index.
     /// Each material's own `add_lobes` takes what it needs of these.

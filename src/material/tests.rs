@@ -451,3 +451,31 @@ fn subsurface_materials_build_with_pbrt_v3_parameters() {
         assert!(matches!(e, Error::At { .. }), "{bad}: {e}");
     }
 }
+
+/// `bsdf_into` over a BSDF that held another material's lobes (more of them, another index)
+/// gives `bsdf`'s BSDF: what bdpt's kept vertices rely on.
+#[test]
+fn bsdf_into_a_used_bsdf_is_bsdf() {
+    let all = typical();
+    let (glass, _) = build(&format!(
+        "Material \"glass\" \"float uroughness\" 0.2\n{SHAPE}"
+    ));
+    let other = SurfaceInteraction::flat(Vec3::new(-0.4, 0.7, 0.0), Vec2::new(0.9, 0.1));
+    for (name, text) in all {
+        let (mats, _) = build(&text);
+        let m = mats.last().unwrap();
+        let mut b = glass.last().unwrap().bsdf(&other);
+        b.add(Bxdf::Lambertian { r: Spectrum::ONE });
+        m.bsdf_into(&si(), &mut b);
+        let want = m.bsdf(&si());
+        assert_eq!(b.lobes(), want.lobes(), "{name}");
+        assert_eq!(b.eta(), want.eta(), "{name}");
+        for wo in test_directions() {
+            for wi in test_directions() {
+                let (w, x) = (want.frame().from_local(wo), want.frame().from_local(wi));
+                assert_eq!(b.f(w, x), want.f(w, x), "{name}");
+                assert_eq!(b.pdf(w, x), want.pdf(w, x), "{name}");
+            }
+        }
+    }
+}

@@ -19,11 +19,13 @@ use std::cell::RefCell;
 
 mod connect;
 mod mis;
+mod path_slots;
 pub mod strategies;
 mod subpath;
 mod vertex;
 
 pub use connect::{connect, Connection};
+pub use path_slots::Subpath;
 pub use subpath::{generate_camera_subpath, generate_camera_subpath_from, generate_light_subpath};
 pub use vertex::{Mode, Vertex, VertexKind};
 
@@ -216,7 +218,7 @@ thread_local! {
     /// The t = 1 strategies' splats of the sample this thread traced last.
     static SPLATS: RefCell<Vec<(Vec2, Spectrum)>> = const { RefCell::new(Vec::new()) };
     /// The subpaths' vertices, reused from sample to sample.
-    static PATHS: RefCell<(Vec<Vertex>, Vec<Vertex>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+    static PATHS: RefCell<(Subpath, Subpath)> = const { RefCell::new((Subpath::new(), Subpath::new())) };
 }
 
 /// The splats (raster position, value) of the sample this thread traced last, taken: the

@@ -2,6 +2,7 @@
 //! `RandomWalk`), generic over where their random decisions come from, so that mlt drives
 //! them from its primary sample space.
 
+use super::path_slots::Subpath;
 use super::vertex::{adjoint_f, correct_shading_normal, Mode, SurfacePoint, Vertex, VertexKind};
 use super::{LightChoice, MAX_PASS_THROUGH};
 use crate::camera::CameraSample;
@@ -17,7 +18,7 @@ pub fn generate_camera_subpath<S: SampleSource + ?Sized>(
     scene: &Scene,
     sampler: &mut S,
     max_depth: usize,
-    path: &mut Vec<Vertex>,
+    path: &mut Subpath,
 ) -> (usize, Vec2) {
     let (w, h) = scene.film.resolution;
     let u = sampler.next_2d();
@@ -39,13 +40,14 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
     diff: Option<&RayDifferentials>,
     sampler: &mut S,
     max_depth: usize,
-    path: &mut Vec<Vertex>,
+    path: &mut Subpath,
 ) -> usize {
     path.clear();
     if max_depth == 0 {
         return 0;
     }
-    path.push(Vertex::camera(ray.o, Vec3::ZERO, ray.time, Spectrum::ONE));
+    let at = (ray.o, Vec3::ZERO, ray.time);
+    path.push_endpoint(VertexKind::Camera, at, Spectrum::ONE, None);
     let pdf_dir = scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
     let walk = Walk {
         beta: Spectrum::ONE,
@@ -65,7 +67,7 @@ pub fn generate_light_subpath<S: SampleSource + ?Sized>(
     max_depth: usize,
     time: f32,
     choice: &LightChoice,
-    path: &mut Vec<Vertex>,
+    path: &mut Subpath,
 ) -> usize {
     path.clear();
     if max_depth == 0 {
@@ -87,9 +89,8 @@ pub fn generate_light_subpath<S: SampleSource + ?Sized>(
     // pbrt-v3 gives lights not on a surface the ray's direction as their normal.
     let on_area = e.n != Vec3::ZERO;
     let n = if on_area { e.n } else { e.d };
-    let mut start = Vertex::endpoint(VertexKind::Light, e.o, n, time, e.le, Some(index as u32));
+    let start = path.push_endpoint(VertexKind::Light, (e.o, n, time), e.le, Some(index as u32));
     start.pdf_fwd = e.pdf_pos * light_pdf;
-    path.push(start);
     let beta = e.le * n.dot(e.d).abs() / (light_pdf * e.pdf_pos * e.pdf_dir);
     let o = if on_area {
         offset_ray_origin(e.o, if n.dot(e.d) < 0.0 { -n } else { n })
@@ -144,7 +145,7 @@ fn random_walk<S: SampleSource + ?Sized>(
     mut diff: Option<&RayDifferentials>,
     sampler: &mut S,
     walk: Walk,
-    path: &mut Vec<Vertex>,
+    path: &mut Subpath,
 ) -> usize {
     if walk.max_depth == 0 {
         return 0;
@@ -196,10 +197,9 @@ fn random_walk<S: SampleSource + ?Sized>(
             // Camera rays that escape end on the infinite lights.
             if mode == Mode::Radiance {
                 let d = ray.d.normalize();
-                let mut v =
-                    Vertex::endpoint(VertexKind::Light, ray.o + d, -d, ray.time, beta, None);
-                v.pdf_fwd = pdf_fwd;
-                path.push(v);
+                let at = (ray.o + d, -d, ray.time);
+                path.push_endpoint(VertexKind::Light, at, beta, None)
+                    .pdf_fwd = pdf_fwd;
                 bounces += 1;
             }
             break;
@@ -221,18 +221,8 @@ fn random_walk<S: SampleSource + ?Sized>(
         let media = super::super::volpath::media_at(&hit.surface, medium);
         let material = &scene.materials[material as usize];
         let si = material.shading(&si);
-        let bsdf = material.bsdf(&si);
-        let prev = path.len() - 1;
-        let point = SurfacePoint { si, bsdf };
-        let vertex = Vertex::surface(
-            point,
-            (hit.surface.area_light, media),
-            beta,
-            pdf_fwd,
-            &path[prev],
-            scene,
-        );
-        path.push(vertex);
+        let at = (hit.surface.area_light, media);
+        path.push_surface((&si, material), at, beta, pdf_fwd, scene);
         bounces += 1;
         if bounces >= max_depth {
             break;

@@ -5,6 +5,7 @@ use super::LightChoice;
 use crate::bsdf::{Bsdf, Bxdf};
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec3};
 use crate::light::{Light, WorldSphere};
+use crate::material::Material;
 use crate::medium::{HenyeyGreenstein, MediumInterface};
 use crate::scene::Scene;
 
@@ -178,6 +179,68 @@ impl Vertex {
             phase: None,
             media: MediumInterface::default(),
         }
+    }
+
+    /// Makes this vertex [`Vertex::endpoint`]'s, field by field (a kept slot of a
+    /// [`super::Subpath`]: no 1 kB vertex built and copied in).
+    pub fn make_endpoint(
+        &mut self,
+        kind: VertexKind,
+        (p, n, time): (Vec3, Vec3, f32),
+        beta: Spectrum,
+        light: Option<u32>,
+    ) {
+        self.kind = kind;
+        self.beta = beta;
+        self.p = p;
+        self.ng = n;
+        self.ns = n;
+        self.time = time;
+        self.delta = false;
+        self.pdf_fwd = 0.0;
+        self.pdf_rev = 0.0;
+        self.light = light;
+        self.surface = None;
+        self.phase = None;
+        self.media = MediumInterface::default();
+    }
+
+    /// Makes this vertex [`Vertex::surface`]'s at the shaded hit `si` with `material`'s BSDF,
+    /// in place: a vertex that held a surface keeps its BSDF's storage and refills it.
+    pub fn make_surface(
+        &mut self,
+        (si, material): (&SurfaceInteraction, &Material),
+        (light, media): (Option<u32>, MediumInterface),
+        beta: Spectrum,
+        pdf: f32,
+        prev: &Vertex,
+        scene: &Scene,
+    ) {
+        self.kind = VertexKind::Surface;
+        self.beta = beta;
+        self.p = si.p;
+        self.ng = si.n;
+        self.ns = si.shading_n;
+        self.time = si.time;
+        self.delta = false;
+        self.pdf_fwd = 0.0;
+        self.pdf_rev = 0.0;
+        self.light = light;
+        self.phase = None;
+        self.media = media;
+        match &mut self.surface {
+            Some(point) => {
+                point.si = *si;
+                material.bsdf_into(&point.si, &mut point.bsdf);
+            }
+            None => {
+                self.surface = Some(SurfacePoint {
+                    si: *si,
+                    bsdf: material.bsdf(si),
+                })
+            }
+        }
+        self.pdf_fwd = prev.convert_density(pdf, self, scene);
     }
 
     /// A surface vertex reached from `prev` with solid-angle density `pdf`.

@@ -7,7 +7,7 @@ use super::contribution::{raster_position, Contribution, PathContribution};
 use super::sampler::{MltSampler, CAMERA_STREAM, CONNECTION_STREAM, LIGHT_STREAM};
 use crate::camera::CameraSample;
 use crate::integrator::bdpt::{
-    connect, generate_camera_subpath_from, generate_light_subpath, LightChoice, Vertex,
+    connect, generate_camera_subpath_from, generate_light_subpath, LightChoice, Subpath,
 };
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -17,7 +17,7 @@ use std::cell::RefCell;
 
 thread_local! {
     /// The camera and light subpaths, reused from evaluation to evaluation.
-    static PATHS: RefCell<(Vec<Vertex>, Vec<Vertex>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+    static PATHS: RefCell<(Subpath, Subpath)> = const { RefCell::new((Subpath::new(), Subpath::new())) };
 }
 
 /// bdpt's paths as mlt's path function (pbrt-v3's `MLTIntegrator::L`).

@@ -21,8 +21,8 @@ use std::time::Instant;
 /// the time limit is looked at (about a second's work on two cores for a simple scene).
 const MUTATIONS_PER_ROUND: u64 = 1 << 18;
 
-/// One chain's round: its splats, what it counted, the mutations it made.
-type Round = (Vec<(Vec2, Spectrum)>, Tally, u64);
+/// One chain's round: what it counted, the mutations it made (its splats are in the chain).
+type Round = (Tally, u64);
 
 /// What the chains share: the path function, the scene and the settings.
 struct Setup<'a, F> {
@@ -140,6 +140,8 @@ struct Chain {
     current_y: f32,
     /// Mutations left.
     left: u64,
+    /// The splats of the round under way (kept from round to round: no allocation per round).
+    splats: Vec<(Vec2, Spectrum)>,
 }
 
 impl Chain {
@@ -165,18 +167,15 @@ impl Chain {
             current,
             current_y: spectrum_luminance(current.l),
             left: mutations,
+            splats: Vec::new(),
         }
     }
 
-    /// Makes up to `n` mutations, pushing their splats (pbrt-v3's: the proposal weighted by
-    /// the acceptance, the current state by its complement, each over its luminance).
-    fn run<F: PathContribution>(
-        &mut self,
-        setup: &Setup<F>,
-        n: u64,
-        splats: &mut Vec<(Vec2, Spectrum)>,
-        tally: &mut Tally,
-    ) -> u64 {
+    /// Makes up to `n` mutations, pushing their splats to `self.splats` (pbrt-v3's: the
+    /// proposal weighted by the acceptance, the current state by its complement, each over its
+    /// luminance).
+    fn run<F: PathContribution>(&mut self, setup: &Setup<F>, n: u64, tally: &mut Tally) -> u64 {
+        let splats = &mut self.splats;
         let n = n.min(self.left);
         for _ in 0..n {
             self.sampler.start_iteration();
@@ -289,13 +288,14 @@ pub fn render_with<F: PathContribution>(
         let rounds: Vec<Round> = chains
             .par_iter_mut()
             .map(|c| {
-                let (mut splats, mut t) = (Vec::new(), Tally::default());
-                let n = c.run(&setup, per_round, &mut splats, &mut t);
-                (splats, t, n)
+                let mut t = Tally::default();
+                let n = c.run(&setup, per_round, &mut t);
+                (t, n)
             })
             .collect();
-        for (splats, t, n) in rounds {
-            film.add_splats(&splats);
+        for (c, (t, n)) in chains.iter_mut().zip(rounds) {
+            film.add_splats(&c.splats);
+            c.splats.clear();
             tally.add(t);
             made += n;
         }

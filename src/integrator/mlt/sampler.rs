@@ -157,7 +157,13 @@ impl MltSampler {
         } else {
             let n_small = self.current_iteration - xi.last_modified;
             let normal = std::f32::consts::SQRT_2 * erf_inv(2.0 * self.rng.next_f32() - 1.0);
-            let eff_sigma = self.sigma * (n_small as f32).sqrt();
+            // A coordinate moved at every iteration (most of them) needs no square root:
+            // sqrt(1) is 1 exactly, so the value is the same.
+            let eff_sigma = if n_small == 1 {
+                self.sigma
+            } else {
+                self.sigma * (n_small as f32).sqrt()
+            };
             xi.value += normal * eff_sigma;
             xi.value -= xi.value.floor();
             // `v - floor(v)` of a tiny negative v rounds to 1.
