@@ -93,6 +93,19 @@ pub struct TriangleVerts {
 }
 
 impl TriangleVerts {
+    /// The record of a primitive that is not a triangle (NaN coordinates, which
+    /// [`TriangleVerts::is_triangle`] tells apart).
+    pub const NONE: Self = Self {
+        xyz: [Vec3A::NAN; 3],
+    };
+
+    /// False for [`TriangleVerts::NONE`] (and for a triangle with a NaN first x, which no ray
+    /// hits either).
+    #[inline(always)]
+    pub fn is_triangle(&self) -> bool {
+        !self.xyz[0].x.is_nan()
+    }
+
     /// From the three vertex positions.
     #[inline]
     pub fn new(p: &[Vec3; 3]) -> Self {
@@ -110,6 +123,12 @@ impl TriangleVerts {
     #[inline]
     fn vertex(&self, i: usize) -> Vec3 {
         Vec3::new(self.xyz[0][i], self.xyz[1][i], self.xyz[2][i])
+    }
+
+    /// The three vertex positions (the same values as the mesh's).
+    #[inline]
+    pub fn vertices(&self) -> [Vec3; 3] {
+        [self.vertex(0), self.vertex(1), self.vertex(2)]
     }
 }
 
