@@ -178,28 +178,30 @@ fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     ys += Vec3A::splat(r.sy) * zs;
 
     // Edge function coefficients: e_i from the two other vertices (i + 1, i + 2).
-    let e = xs.yzx() * ys.zxy() - ys.yzx() * xs.zxy();
-    let (mut e0, mut e1, mut e2) = (e.x, e.y, e.z);
+    let mut e = xs.yzx() * ys.zxy() - ys.yzx() * xs.zxy();
     let [p0x, p1x, p2x] = xs.to_array();
     let [p0y, p1y, p2y] = ys.to_array();
 
     // Fall back to double precision at triangle edges.
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+    if e.cmpeq(Vec3A::ZERO).any() {
         let p2txp1ty = p2x as f64 * p1y as f64;
         let p2typ1tx = p2y as f64 * p1x as f64;
-        e0 = (p2typ1tx - p2txp1ty) as f32;
+        let e0 = (p2typ1tx - p2txp1ty) as f32;
         let p0txp2ty = p0x as f64 * p2y as f64;
         let p0typ2tx = p0y as f64 * p2x as f64;
-        e1 = (p0typ2tx - p0txp2ty) as f32;
+        let e1 = (p0typ2tx - p0txp2ty) as f32;
         let p1txp0ty = p1x as f64 * p0y as f64;
         let p1typ0tx = p1y as f64 * p0x as f64;
-        e2 = (p1typ0tx - p1txp0ty) as f32;
+        let e2 = (p1typ0tx - p1txp0ty) as f32;
+        e = Vec3A::new(e0, e1, e2);
     }
 
-    // Edge and determinant tests.
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+    // Edge and determinant tests: edges of both signs miss. One branch on the lanes' signs
+    // (most triangles a ray is tested against fail here, unpredictably).
+    if e.cmplt(Vec3A::ZERO).any() & e.cmpgt(Vec3A::ZERO).any() {
         return None;
     }
+    let (e0, e1, e2) = (e.x, e.y, e.z);
     let det = e0 + e1 + e2;
     // (NaN: a degenerate ray direction.)
     if det == 0.0 || det.is_nan() {
