@@ -143,7 +143,7 @@ pub fn intersect_triangle_vertices(
 }
 
 /// [`intersect_triangle`] on vertices stored by coordinate and a prepared ray.
-#[inline]
+#[inline(always)]
 pub fn intersect_triangle_verts(
     v: &TriangleVerts,
     r: &TriangleRay,
