@@ -9,7 +9,7 @@
 
 use crate::geometry::{Ray, SurfaceInteraction, Vec3};
 use crate::shapes::triangle::{
-    intersect_triangle_verts, triangle_bounds, triangle_interaction, TriangleRay, TriangleVerts,
+    intersect_triangle_verts, triangle_bounds, triangle_interaction_at, TriangleRay, TriangleVerts,
 };
 use crate::shapes::{Curve, CurveCommon, Cylinder, Disk, Revolved, Sphere, TriangleMesh};
 use crate::transform::MotionTransform;
@@ -21,6 +21,7 @@ use rayon::prelude::*;
 use std::time::Duration;
 
 mod crossing;
+mod traverse;
 mod wide;
 
 /// What a BVH leaf primitive is, and the surface (material, area light) it carries.
@@ -114,6 +115,8 @@ pub struct Hit {
     pub prim: Prim,
     /// The instance it belongs to, if any.
     instance: Option<u32>,
+    /// The primitive's leaf-order index in its geometry.
+    leaf: u32,
     local: LocalHit,
 }
 
@@ -221,7 +224,7 @@ impl Geometry {
                 PrimKind::Triangle { mesh, tri } => {
                     TriangleVerts::new(&self.meshes[mesh as usize].vertices(tri as usize))
                 }
-                _ => TriangleVerts::default(),
+                _ => TriangleVerts::NONE,
             })
             .collect();
     }
@@ -235,6 +238,13 @@ impl Geometry {
         tri_ray: &TriangleRay,
         t_max: f32,
     ) -> Option<(f32, LocalHit)> {
+        // Triangles are known by their vertex record, which their test reads anyway: the
+        // primitive's own record is read for the other kinds only.
+        let verts = &self.tri_verts[id];
+        if verts.is_triangle() {
+            return intersect_triangle_verts(verts, tri_ray, t_max)
+                .map(|h| (h.t, LocalHit::Triangle(h)));
+        }
         match self.prims[id].kind {
             PrimKind::Triangle { .. } => {
                 intersect_triangle_verts(&self.tri_verts[id], tri_ray, t_max)
@@ -263,25 +273,24 @@ impl Geometry {
     /// The closest hit closer than `t_max`.
     pub fn intersect(&self, ray: &Ray, t_max: f32, instance: Option<u32>) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
-        let mut best: Option<Hit> = None;
-        let mut hit = obvhs::ray::RayHit::none();
+        let mut best: Option<(f32, usize, LocalHit)> = None;
         let tri_ray = TriangleRay::new(ray);
-        bvh.ray_traverse(to_obvhs(ray, t_max), &mut hit, |r, id| {
-            let prim = &self.prims[id];
+        traverse::closest(bvh, to_obvhs(ray, t_max), |r, id| {
             match self.intersect_prim(id, ray, &tri_ray, r.tmax) {
                 Some((t, local)) => {
-                    best = Some(Hit {
-                        t,
-                        prim: *prim,
-                        instance,
-                        local,
-                    });
+                    best = Some((t, id, local));
                     t
                 }
                 None => f32::INFINITY,
             }
         });
-        best
+        best.map(|(t, id, local)| Hit {
+            t,
+            prim: self.prims[id],
+            instance,
+            leaf: id as u32,
+            local,
+        })
     }
 
     /// [`Geometry::intersect`] for an instance's geometry, whose box the top-level BVH has
@@ -315,7 +324,7 @@ impl Geometry {
             return false;
         };
         let tri_ray = TriangleRay::new(ray);
-        !bvh.ray_traverse_miss(to_obvhs(ray, t_max), |r, id| {
+        !traverse::misses(bvh, to_obvhs(ray, t_max), |r, id| {
             self.intersect_prim(id, ray, &tri_ray, r.tmax)
                 .map_or(f32::INFINITY, |(t, _)| t)
         })
@@ -324,9 +333,14 @@ impl Geometry {
     /// The full interaction of a hit, in this geometry's space.
     fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
         match (hit.prim.kind, &hit.local) {
-            (PrimKind::Triangle { mesh, tri }, LocalHit::Triangle(h)) => {
-                triangle_interaction(&self.meshes[mesh as usize], tri as usize, ray, h)
-            }
+            // The positions from the traversal's record, which the hit has just read.
+            (PrimKind::Triangle { mesh, tri }, LocalHit::Triangle(h)) => triangle_interaction_at(
+                &self.meshes[mesh as usize],
+                tri as usize,
+                self.tri_verts[hit.leaf as usize].vertices(),
+                ray,
+                h,
+            ),
             (PrimKind::Sphere(i), LocalHit::Sphere(h)) => {
                 self.spheres[i as usize].interaction(ray, hit.t, h)
             }

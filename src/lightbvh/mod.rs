@@ -316,19 +316,21 @@ impl LightBvh {
                 return None;
             }
             // The child whose share of the total holds u (past the last share, by rounding:
-            // the last child that has one).
+            // the last child that has one). The four shares in one division (each lane's
+            // quotient is the scalar one).
+            let shares = importance / Vec4::splat(total);
             let (mut k, mut below, mut start) = (4, 0.0, 0.0);
             for j in 0..4 {
                 if importance[j] > 0.0 {
                     (k, start) = (j, below);
-                    below += importance[j] / total;
+                    below += shares[j];
                     if u < below {
                         break;
                     }
                 }
             }
             below = start;
-            let p = importance[k] / total;
+            let p = shares[k];
             u = clamp_u((u - below) / p);
             pmf *= p;
             let link = node.links[k];

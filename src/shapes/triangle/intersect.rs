@@ -93,6 +93,19 @@ pub struct TriangleVerts {
 }
 
 impl TriangleVerts {
+    /// The record of a primitive that is not a triangle (NaN coordinates, which
+    /// [`TriangleVerts::is_triangle`] tells apart).
+    pub const NONE: Self = Self {
+        xyz: [Vec3A::NAN; 3],
+    };
+
+    /// False for [`TriangleVerts::NONE`] (and for a triangle with a NaN first x, which no ray
+    /// hits either).
+    #[inline(always)]
+    pub fn is_triangle(&self) -> bool {
+        !self.xyz[0].x.is_nan()
+    }
+
     /// From the three vertex positions.
     #[inline]
     pub fn new(p: &[Vec3; 3]) -> Self {
@@ -111,6 +124,12 @@ impl TriangleVerts {
     fn vertex(&self, i: usize) -> Vec3 {
         Vec3::new(self.xyz[0][i], self.xyz[1][i], self.xyz[2][i])
     }
+
+    /// The three vertex positions (the same values as the mesh's).
+    #[inline]
+    pub fn vertices(&self) -> [Vec3; 3] {
+        [self.vertex(0), self.vertex(1), self.vertex(2)]
+    }
 }
 
 /// [`intersect_triangle`] on the triangle's three vertices and a prepared ray.
@@ -124,7 +143,7 @@ pub fn intersect_triangle_vertices(
 }
 
 /// [`intersect_triangle`] on vertices stored by coordinate and a prepared ray.
-#[inline]
+#[inline(always)]
 pub fn intersect_triangle_verts(
     v: &TriangleVerts,
     r: &TriangleRay,
@@ -159,28 +178,30 @@ fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
     ys += Vec3A::splat(r.sy) * zs;
 
     // Edge function coefficients: e_i from the two other vertices (i + 1, i + 2).
-    let e = xs.yzx() * ys.zxy() - ys.yzx() * xs.zxy();
-    let (mut e0, mut e1, mut e2) = (e.x, e.y, e.z);
+    let mut e = xs.yzx() * ys.zxy() - ys.yzx() * xs.zxy();
     let [p0x, p1x, p2x] = xs.to_array();
     let [p0y, p1y, p2y] = ys.to_array();
 
     // Fall back to double precision at triangle edges.
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+    if e.cmpeq(Vec3A::ZERO).any() {
         let p2txp1ty = p2x as f64 * p1y as f64;
         let p2typ1tx = p2y as f64 * p1x as f64;
-        e0 = (p2typ1tx - p2txp1ty) as f32;
+        let e0 = (p2typ1tx - p2txp1ty) as f32;
         let p0txp2ty = p0x as f64 * p2y as f64;
         let p0typ2tx = p0y as f64 * p2x as f64;
-        e1 = (p0typ2tx - p0txp2ty) as f32;
+        let e1 = (p0typ2tx - p0txp2ty) as f32;
         let p1txp0ty = p1x as f64 * p0y as f64;
         let p1typ0tx = p1y as f64 * p0x as f64;
-        e2 = (p1typ0tx - p1txp0ty) as f32;
+        let e2 = (p1typ0tx - p1txp0ty) as f32;
+        e = Vec3A::new(e0, e1, e2);
     }
 
-    // Edge and determinant tests.
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+    // Edge and determinant tests: edges of both signs miss. One branch on the lanes' signs
+    // (most triangles a ray is tested against fail here, unpredictably).
+    if e.cmplt(Vec3A::ZERO).any() & e.cmpgt(Vec3A::ZERO).any() {
         return None;
     }
+    let (e0, e1, e2) = (e.x, e.y, e.z);
     let det = e0 + e1 + e2;
     // (NaN: a degenerate ray direction.)
     if det == 0.0 || det.is_nan() {

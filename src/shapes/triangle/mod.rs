@@ -138,7 +138,19 @@ pub fn triangle_interaction(
     ray: &Ray,
     hit: &TriangleHit,
 ) -> SurfaceInteraction {
-    let p = mesh.vertices(tri);
+    triangle_interaction_at(mesh, tri, mesh.vertices(tri), ray, hit)
+}
+
+/// [`triangle_interaction`] with the triangle's vertex positions `p` given (a copy the caller
+/// already holds): a mesh without normals or uvs is then not read past its header.
+#[inline]
+pub fn triangle_interaction_at(
+    mesh: &TriangleMesh,
+    tri: usize,
+    p: [Vec3; 3],
+    ray: &Ray,
+    hit: &TriangleHit,
+) -> SurfaceInteraction {
     let uv = mesh.uvs_of(tri);
     let (b0, b1, b2) = (hit.b0, hit.b1, hit.b2);
     let (dpdu, dpdv) = triangle_dpduv(&p, &uv);
