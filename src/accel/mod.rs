@@ -74,8 +74,8 @@ pub struct Geometry {
     pub curves: Vec<Curve>,
     /// Primitives in BVH leaf order.
     prims: Vec<Prim>,
-    /// The vertices of each triangle primitive, in leaf order beside `prims` (zeros for other
-    /// kinds): the traversal reads one contiguous record instead of three indirections.
+    /// The vertices of each triangle primitive, in leaf order beside `prims` (NaN for other
+    /// kinds, `TriangleVerts::NONE`): the traversal reads one contiguous record instead of three indirections.
     tri_verts: Vec<TriangleVerts>,
     bvh: Option<CwBvh>,
 }
@@ -305,6 +305,7 @@ impl Geometry {
             t,
             prim: self.prims[0],
             instance: Some(instance),
+            leaf: 0,
             local,
         })
     }
