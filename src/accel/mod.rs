@@ -75,7 +75,8 @@ pub struct Geometry {
     /// Primitives in BVH leaf order.
     prims: Vec<Prim>,
     /// The vertices of each triangle primitive, in leaf order beside `prims` (NaN for other
-    /// kinds, `TriangleVerts::NONE`): the traversal reads one contiguous record instead of three indirections.
+    /// kinds, `TriangleVerts::NONE`): the traversal reads one contiguous record instead of
+    /// three indirections.
     tri_verts: Vec<TriangleVerts>,
     bvh: Option<CwBvh>,
 }
