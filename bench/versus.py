@@ -35,6 +35,7 @@ import gzip
 import os
 import platform
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -48,20 +49,40 @@ BEGIN, END = "<!-- versus:begin -->", "<!-- versus:end -->"
 # frame each), whatever --spp asks of the small scenes.
 INTERIOR_SPP = {"conference_room": 8, "theater": 4}
 ONE_PIXEL = "0,1,0,1"
+RSS_TAG = "versus-peak-kib "
+
+
+def gnu_time():
+    """GNU time's path when it is installed, else None."""
+    path = "/usr/bin/time"
+    if not os.access(path, os.X_OK):
+        return None
+    probe = subprocess.run([path, "-f", f"{RSS_TAG}%M", "true"], capture_output=True, text=True)
+    return path if RSS_TAG in probe.stderr else None
 
 
 def run(cmd):
-    """Runs cmd to completion: (seconds, peak RSS in MiB, exit status, stderr tail)."""
+    """Runs cmd to completion: (seconds, peak RSS in MiB, exit status, stderr tail).
+    The peak comes from GNU time, the renderer's parent, where it is installed: a child of
+    this script reports at least this script's own peak (Linux carries the parent's
+    high-water mark over the exec), which a decompressed interior makes about 100 MiB."""
+    launcher = GNU_TIME
+    wrapped = [launcher, "-f", f"{RSS_TAG}%M"] + cmd if launcher else cmd
     with tempfile.TemporaryFile() as err:
         start = time.perf_counter()
-        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
+        proc = subprocess.Popen(wrapped, stdout=subprocess.DEVNULL, stderr=err)
         _, status, usage = os.wait4(proc.pid, 0)
         seconds = time.perf_counter() - start
         proc.returncode = os.waitstatus_to_exitcode(status)
         err.seek(0)
-        tail = err.read().decode(errors="replace").strip().splitlines()[-3:]
-    # ru_maxrss is in KiB on Linux.
-    return seconds, usage.ru_maxrss / 1024.0, proc.returncode, " / ".join(tail)
+        lines = err.read().decode(errors="replace").strip().splitlines()
+    # Both in KiB on Linux.
+    peak_kib = usage.ru_maxrss
+    if launcher and lines and lines[-1].startswith(RSS_TAG):
+        peak_kib = int(lines.pop()[len(RSS_TAG):])
+    if lines and lines[-1].startswith("Command exited with non-zero status"):
+        lines.pop()
+    return seconds, peak_kib / 1024.0, proc.returncode, " / ".join(lines[-3:])
 
 
 def inlined(path, base, depth=0):
@@ -136,7 +157,7 @@ def decompressed(scene):
         return None
     path = os.path.join(os.path.dirname(scene), f".versus-text-{scene_name(scene)}.pbrt")
     with gzip.open(scene, "rb") as src, open(path, "wb") as dst:
-        dst.write(src.read())
+        shutil.copyfileobj(src, dst)
     return path
 
 
@@ -252,6 +273,9 @@ def write(out, text):
         new = old + ("\n" if old and not old.endswith("\n") else "") + block + "\n"
     with open(out, "w") as f:
         f.write(new)
+
+
+GNU_TIME = gnu_time()
 
 
 def main():
