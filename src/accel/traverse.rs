@@ -133,3 +133,86 @@ pub(super) fn misses<F: FnMut(&Ray, usize) -> f32>(bvh: &CwBvh, ray: Ray, mut hi
     }
     miss
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec3, Vec3A};
+
+    /// A small deterministic generator (xorshift64*), enough to spread the cases.
+    struct Cases(u64);
+    impl Cases {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        fn unit(&mut self) -> f32 {
+            (self.next() >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn byte(&mut self) -> u8 {
+            (self.next() >> 56) as u8
+        }
+        fn signed(&mut self) -> f32 {
+            self.unit() * 2.0 - 1.0
+        }
+    }
+
+    /// A node with random children's quantised planes (min at most max) around `p`.
+    fn node(c: &mut Cases) -> CwBvhNode {
+        let mut n = CwBvhNode {
+            p: Vec3::new(c.signed(), c.signed(), c.signed()) * 4.0,
+            e: [120 + c.byte() % 8, 120 + c.byte() % 8, 120 + c.byte() % 8],
+            imask: c.byte(),
+            child_meta: [0; 8],
+            ..Default::default()
+        };
+        for i in 0..8 {
+            n.child_meta[i] = c.byte();
+            for (lo, hi) in [
+                (&mut n.child_min_x, &mut n.child_max_x),
+                (&mut n.child_min_y, &mut n.child_max_y),
+                (&mut n.child_min_z, &mut n.child_max_z),
+            ] {
+                let (a, b) = (c.byte(), c.byte());
+                lo[i] = a.min(b);
+                hi[i] = a.max(b);
+            }
+        }
+        n
+    }
+
+    /// obvhs's octant code of a direction, as its traversal computes it.
+    fn oct_inv4(d: Vec3A) -> u32 {
+        let oct = u32::from(d.x < 0.0) | u32::from(d.y < 0.0) << 1 | u32::from(d.z < 0.0) << 2;
+        (7 - oct) * 0x0101_0101
+    }
+
+    /// The node test (the 8-lane one where the build has AVX2) gives obvhs's own hit masks.
+    #[test]
+    fn node_test_gives_obvhs_hit_masks() {
+        let mut c = Cases(0x9e37_79b9_7f4a_7c15);
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let n = node(&mut c);
+            let o = Vec3A::new(c.signed(), c.signed(), c.signed()) * 8.0;
+            let mut d = Vec3A::new(c.signed(), c.signed(), c.signed());
+            if c.byte() < 128 {
+                // Half the rays aimed near the node's corner, where its children lie.
+                d = Vec3A::from(n.p) + Vec3A::new(c.unit(), c.unit(), c.unit()) * 2.0 - o;
+            }
+            if c.byte() < 32 {
+                // Axis-aligned rays: zero components give infinite inverses.
+                d.y = 0.0;
+            }
+            let ray = Ray::new(o, d.normalize_or(Vec3A::X), 0.0, 1.0 + 30.0 * c.unit());
+            let inv = oct_inv4(ray.direction);
+            let ours = node_hits(&n, &ray, inv);
+            assert_eq!(ours, n.intersect_ray(&ray, inv), "node {n:?} ray {ray:?}");
+            hits += u32::from(ours != 0);
+        }
+        // The cases must exercise hits, not only misses.
+        assert!(hits > 500, "only {hits} of the cases hit a child");
+    }
+}
