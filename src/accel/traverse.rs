@@ -55,17 +55,16 @@ fn enter_scalar(node: &CwBvhNode, ray: &Ray) -> (u32, [f32; 8]) {
     ];
     let mut mask = 0;
     let mut entry = [0.0f32; 8];
-    for slot in 0..8 {
-        let mut t = [[0.0f32; 2]; 3];
-        for a in 0..3 {
+    for (slot, e) in entry.iter_mut().enumerate() {
+        let t: [[f32; 2]; 3] = std::array::from_fn(|a| {
             let (lo, hi) = (planes[a].0[slot] as f32, planes[a].1[slot] as f32);
             let (near, far) = if negative[a] { (hi, lo) } else { (lo, hi) };
             // Multiply then add, unfused, as obvhs does.
-            t[a] = [near * dir_inv[a] + orig[a], far * dir_inv[a] + orig[a]];
-        }
+            [near * dir_inv[a] + orig[a], far * dir_inv[a] + orig[a]]
+        });
         let tmin = t[0][0].max(t[1][0].max(t[2][0])).max(NODE_EPSILON);
         let tmax = t[0][1].min(t[1][1].min(t[2][1])).min(ray.tmax);
-        entry[slot] = tmin;
+        *e = tmin;
         if tmin <= tmax && node.child_meta[slot] != 0 {
             mask |= 1 << slot;
         }
