@@ -84,7 +84,7 @@ pub struct Geometry {
 
 /// Above this many primitives a geometry's BVH is built by [`wide::build_wide`], below by
 /// obvhs's PLOC builder. On a million triangles the wide builder is 3.7x faster (0.3 s against
-/// 1.1 s), needs 190 MiB less and traces as fast; on the interiors (110,000 to 130,000
+/// 1.1 s), needs 190 MiB less and traces as fast; on the interiors (106,000 to 125,000
 /// primitives of very mixed sizes) PLOC's trees with its optimal wide collapse made the whole
 /// render 0.90x the CPU time of the wide builder's (docs/BENCHMARKS.md).
 const WIDE_BUILD_MIN: usize = 300_000;
