@@ -9,7 +9,8 @@
 
 use crate::geometry::{Ray, SurfaceInteraction, Vec3};
 use crate::shapes::triangle::{
-    intersect_triangle_verts, triangle_bounds, triangle_interaction_at, TriangleRay, TriangleVerts,
+    intersect_triangle_verts, triangle_bounds, triangle_interaction_at, Corners, TriangleRay,
+    TriangleVerts,
 };
 use crate::shapes::{Curve, CurveCommon, Cylinder, Disk, Revolved, Sphere, TriangleMesh};
 use crate::transform::MotionTransform;
@@ -82,10 +83,11 @@ pub struct Geometry {
 }
 
 /// Above this many primitives a geometry's BVH is built by [`wide::build_wide`], below by
-/// obvhs's PLOC builder. The wide builder is 1.6x faster on a million triangles and traces as
-/// fast there; on small scenes PLOC's optimal wide collapse traces up to 8% faster (measured on
-/// instancing and pbrt-v3's Cornell box, docs/BENCHMARKS.md), and its build time is negligible.
-const WIDE_BUILD_MIN: usize = 100_000;
+/// obvhs's PLOC builder. On a million triangles the wide builder is 3.7x faster (0.3 s against
+/// 1.1 s), needs 190 MiB less and traces as fast; on the interiors (106,000 to 125,000
+/// primitives of very mixed sizes) PLOC's trees with its optimal wide collapse made the whole
+/// render 0.90x the CPU time of the wide builder's (docs/BENCHMARKS.md).
+const WIDE_BUILD_MIN: usize = 300_000;
 
 /// The BVH builders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -197,6 +199,13 @@ impl Geometry {
         if self.prims.is_empty() {
             return;
         }
+        // The walk names a leaf's primitives in 29 bits (a 25 GB geometry of triangles).
+        assert!(
+            self.prims.len() < traverse::MAX_PRIMITIVES,
+            "a geometry of {} primitives: at most {} are supported",
+            self.prims.len(),
+            traverse::MAX_PRIMITIVES - 1
+        );
         let bounds = |i: usize| {
             let (lo, hi) = self.prim_bounds(&self.prims[i]);
             Aabb::new(Vec3A::from(lo), Vec3A::from(hi))
@@ -223,7 +232,9 @@ impl Geometry {
             .par_iter()
             .map(|p| match p.kind {
                 PrimKind::Triangle { mesh, tri } => {
-                    TriangleVerts::new(&self.meshes[mesh as usize].vertices(tri as usize))
+                    let m = &self.meshes[mesh as usize];
+                    let indices = m.vertex_indices(tri as usize).map(|i| i as u32);
+                    TriangleVerts::with_indices(&m.vertices(tri as usize), Some(indices))
                 }
                 _ => TriangleVerts::NONE,
             })
@@ -335,14 +346,16 @@ impl Geometry {
     /// The full interaction of a hit, in this geometry's space.
     fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
         match (hit.prim.kind, &hit.local) {
-            // The positions from the traversal's record, which the hit has just read.
-            (PrimKind::Triangle { mesh, tri }, LocalHit::Triangle(h)) => triangle_interaction_at(
-                &self.meshes[mesh as usize],
-                tri as usize,
-                self.tri_verts[hit.leaf as usize].vertices(),
-                ray,
-                h,
-            ),
+            // The positions and vertex indices from the traversal's record, which the hit has
+            // just read.
+            (PrimKind::Triangle { mesh, tri }, LocalHit::Triangle(h)) => {
+                let verts = &self.tri_verts[hit.leaf as usize];
+                let at = Corners {
+                    tri: tri as usize,
+                    known: verts.indices(),
+                };
+                triangle_interaction_at(&self.meshes[mesh as usize], &at, verts.vertices(), ray, h)
+            }
             (PrimKind::Sphere(i), LocalHit::Sphere(h)) => {
                 self.spheres[i as usize].interaction(ray, hit.t, h)
             }

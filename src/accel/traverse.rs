@@ -1,49 +1,88 @@
-//! Walks of obvhs's compressed wide BVH with our own node test: the eight children's boxes
-//! in one 8-lane pass where the CPU has AVX2 (obvhs tests them as two 4-lane halves). The
-//! walk itself is obvhs's (its `traverse!` macro), so children and primitives are visited in
-//! the same order, and every lane computes what obvhs's test computes, in the same order of
-//! operations: the same hits, bit for bit.
+//! Walks of obvhs's compressed wide BVH (its node layout, built by obvhs or by `wide.rs`) with
+//! our own node test and our own order: the eight children's boxes in one 8-lane pass where
+//! the CPU has AVX2, and the children a ray enters visited nearest first from a stack that
+//! keeps each one's entry distance, so that an entry lying beyond a hit found since it was
+//! pushed is dropped without loading its node (obvhs's walk, made for GPUs, orders children by
+//! the ray's octant only and visits every child it pushed). Each lane computes obvhs's box test
+//! in obvhs's order of operations, so the children entered are obvhs's; the closest hit is
+//! the same distance, and only which of two hits at the same distance wins can differ.
 
-// obvhs's `traverse!` names `UVec2` unqualified.
-use glam::UVec2;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::Ray;
+use std::mem::MaybeUninit;
 
 /// obvhs's floor on a box's entry distance (`cwbvh::node::EPSILON`, private to it).
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 const NODE_EPSILON: f32 = 0.0001;
 
-/// The children of `node` that `ray` enters before `ray.tmax`, as obvhs's hit mask: the
-/// internal children's bits in the high byte (by traversal priority), the leaves' primitives
-/// in the low 24 bits.
+/// A target of the walk marked as a leaf: its primitives' count in bits 29-30, the first's
+/// index below. Otherwise the target is a node's index.
+const LEAF: u32 = 1 << 31;
+
+/// The most primitives a geometry may have for leaf targets to name them.
+pub(super) const MAX_PRIMITIVES: usize = 1 << 29;
+
+/// The children of `node` that `ray` enters before `ray.tmax` (a bit per slot, empty slots
+/// never set) and every slot's entry distance (meaningful where the bit is set).
 #[inline(always)]
-fn node_hits(node: &CwBvhNode, ray: &Ray, oct_inv4: u32) -> u32 {
+fn enter(node: &CwBvhNode, ray: &Ray) -> (u32, [f32; 8]) {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     {
         // SAFETY: the target has AVX2 (checked at compile time above).
-        unsafe { node_hits_avx2(node, ray, oct_inv4) }
+        unsafe { enter_avx2(node, ray) }
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     {
-        node.intersect_ray(ray, oct_inv4)
+        enter_scalar(node, ray)
     }
 }
 
-/// [`node_hits`] on eight lanes: each child's quantised planes widened from bytes, scaled
-/// and offset into ray distances exactly as obvhs's `intersect_ray_simd` does per lane.
+/// [`enter`] one slot at a time, each as a lane of [`enter_avx2`] computes it.
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
+#[inline(always)]
+fn enter_scalar(node: &CwBvhNode, ray: &Ray) -> (u32, [f32; 8]) {
+    let dir_inv = node.compute_extent() * ray.inv_direction;
+    let orig = (glam::Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+    let negative = [
+        ray.direction.x < 0.0,
+        ray.direction.y < 0.0,
+        ray.direction.z < 0.0,
+    ];
+    let planes = [
+        (&node.child_min_x, &node.child_max_x),
+        (&node.child_min_y, &node.child_max_y),
+        (&node.child_min_z, &node.child_max_z),
+    ];
+    let mut mask = 0;
+    let mut entry = [0.0f32; 8];
+    for (slot, e) in entry.iter_mut().enumerate() {
+        let t: [[f32; 2]; 3] = std::array::from_fn(|a| {
+            let (lo, hi) = (planes[a].0[slot] as f32, planes[a].1[slot] as f32);
+            let (near, far) = if negative[a] { (hi, lo) } else { (lo, hi) };
+            // Multiply then add, unfused, as obvhs does.
+            [near * dir_inv[a] + orig[a], far * dir_inv[a] + orig[a]]
+        });
+        let tmin = t[0][0].max(t[1][0].max(t[2][0])).max(NODE_EPSILON);
+        let tmax = t[0][1].min(t[1][1].min(t[2][1])).min(ray.tmax);
+        *e = tmin;
+        if tmin <= tmax && node.child_meta[slot] != 0 {
+            mask |= 1 << slot;
+        }
+    }
+    (mask, entry)
+}
+
+/// [`enter`] on eight lanes: each child's quantised planes widened from bytes, scaled and
+/// offset into ray distances exactly as obvhs's `intersect_ray_simd` does per lane.
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 #[inline(always)]
-unsafe fn node_hits_avx2(node: &CwBvhNode, ray: &Ray, oct_inv4: u32) -> u32 {
+unsafe fn enter_avx2(node: &CwBvhNode, ray: &Ray) -> (u32, [f32; 8]) {
     use std::arch::x86_64::*;
     let dir_inv = node.compute_extent() * ray.inv_direction;
     let orig = (glam::Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+    let bytes = |v: &[u8; 8]| _mm256_cvtepu8_epi32(_mm_loadl_epi64(v.as_ptr() as *const __m128i));
     // Eight bytes to eight floats.
-    let q = |v: &[u8; 8]| {
-        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
-            v.as_ptr() as *const __m128i
-        )))
-    };
+    let q = |v: &[u8; 8]| _mm256_cvtepi32_ps(bytes(v));
     let axis = |lo: &[u8; 8], hi: &[u8; 8], negative: bool, d: f32, o: f32| {
         let (q_lo, q_hi) = (q(lo), q(hi));
         let (near, far) = if negative { (q_hi, q_lo) } else { (q_lo, q_hi) };
@@ -79,59 +118,166 @@ unsafe fn node_hits_avx2(node: &CwBvhNode, ray: &Ray, oct_inv4: u32) -> u32 {
     let tmax = _mm256_min_ps(tmax_x, _mm256_min_ps(tmax_y, tmax_z));
     let tmin = _mm256_max_ps(tmin, _mm256_set1_ps(NODE_EPSILON));
     let tmax = _mm256_min_ps(tmax, _mm256_set1_ps(ray.tmax));
-    let mut mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(tmin, tmax)) as u32;
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
-    let mut hit_mask = 0u32;
-    while mask != 0 {
-        let shift = mask.trailing_zeros() * 8;
-        mask &= mask - 1;
-        let child_bits = ((child_bits8 >> shift) as u32) & 0xff;
-        let bit_index = ((bit_index8 >> shift) as u32) & 0xff;
-        hit_mask |= child_bits << bit_index;
-    }
-    hit_mask
+    let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(tmin, tmax)) as u32;
+    // Empty slots (meta byte zero) have zero planes, which a ray may well cross.
+    let empty = _mm256_cmpeq_epi32(bytes(&node.child_meta), _mm256_setzero_si256());
+    let empty = _mm256_movemask_ps(_mm256_castsi256_ps(empty)) as u32;
+    let mut entry = [0.0f32; 8];
+    _mm256_storeu_ps(entry.as_mut_ptr(), tmin);
+    (hit & !empty, entry)
 }
 
-/// obvhs's `CwBvh::ray_traverse` with [`node_hits`]: calls `hit_fn(ray, primitive)` for each
-/// primitive in a leaf the ray enters, shortening the ray to every distance it returns that is
-/// closer. Gives the closest such distance (`ray.tmax` when none).
+/// The walk's target for the child in `slot` of `node`: a node's index, or a leaf.
 #[inline(always)]
-pub(super) fn closest<F: FnMut(&Ray, usize) -> f32>(bvh: &CwBvh, ray: Ray, mut hit_fn: F) -> f32 {
-    let mut traverse_ray = ray;
-    let mut state = bvh.new_traversal(ray.direction);
-    let mut node;
-    obvhs::traverse!(
-        bvh,
-        node,
-        state,
-        node_hits(node, &traverse_ray, state.oct_inv4),
-        {
-            let t = hit_fn(&traverse_ray, state.primitive_id as usize);
-            if t < traverse_ray.tmax {
-                traverse_ray.tmax = t;
+fn target(node: &CwBvhNode, slot: u32) -> u32 {
+    if node.imask & (1 << slot) != 0 {
+        // Inner children are stored in slot order from the node's child base.
+        node.child_base_idx + (u32::from(node.imask) & ((1 << slot) - 1)).count_ones()
+    } else {
+        let meta = u32::from(node.child_meta[slot as usize]);
+        let first = node.primitive_base_idx + (meta & 0x1f);
+        LEAF | (meta >> 5).count_ones() << 29 | first
+    }
+}
+
+/// The primitives of a leaf target.
+#[inline(always)]
+fn leaf_range(target: u32) -> std::ops::Range<usize> {
+    let first = (target & (MAX_PRIMITIVES as u32 - 1)) as usize;
+    first..first + ((target >> 29) & 3) as usize
+}
+
+/// Room for the entries a walk holds: at most seven per level of the tree (obvhs's trees, like
+/// its own traversal's stack, stay within 32 levels; the wide builder's too).
+const STACK: usize = 7 * 64 + 8;
+
+/// Pending targets, each with its entry distance's bits above (distances are positive, so the
+/// bits order as the distances do).
+struct Stack {
+    entries: [MaybeUninit<u64>; STACK],
+    len: usize,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            entries: [MaybeUninit::uninit(); STACK],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, entry: u64) {
+        // Indexing checks the bound: a tree deeper than the stack stops the walk loudly.
+        self.entries[self.len] = MaybeUninit::new(entry);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<u64> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: every entry below `len` was written by `push`.
+        Some(unsafe { self.entries[self.len].assume_init() })
+    }
+}
+
+/// The entries of the children `mask` names, sorted farthest first with `sort` (else in slot
+/// order); gives their count.
+#[inline(always)]
+fn children(
+    node: &CwBvhNode,
+    mut mask: u32,
+    entry: &[f32; 8],
+    out: &mut [u64; 8],
+    sort: bool,
+) -> usize {
+    let mut n = 0;
+    while mask != 0 {
+        let slot = mask.trailing_zeros();
+        mask &= mask - 1;
+        let key = u64::from(entry[slot as usize].to_bits()) << 32 | u64::from(target(node, slot));
+        // Insertion, farthest first.
+        let mut i = n;
+        while sort && i > 0 && out[i - 1] < key {
+            out[i] = out[i - 1];
+            i -= 1;
+        }
+        out[i] = key;
+        n += 1;
+    }
+    n
+}
+
+/// Calls `hit_fn(ray, primitive)` for each primitive in a leaf the ray enters, nearest leaf
+/// first, shortening the ray to every distance it returns that is closer; with `ANY`, stops at
+/// the first such distance. Gives the ray's final `tmax`.
+#[inline(always)]
+fn walk<const ANY: bool, F: FnMut(&Ray, usize) -> f32>(
+    bvh: &CwBvh,
+    mut ray: Ray,
+    mut hit_fn: F,
+) -> f32 {
+    if bvh.nodes.is_empty() {
+        return ray.tmax;
+    }
+    let mut stack = Stack::new();
+    let mut current = 0u32;
+    let mut kids = [0u64; 8];
+    loop {
+        if current & LEAF != 0 {
+            for id in leaf_range(current) {
+                let t = hit_fn(&ray, id);
+                if t < ray.tmax {
+                    ray.tmax = t;
+                    if ANY {
+                        return t;
+                    }
+                }
+            }
+        } else {
+            let node = &bvh.nodes[current as usize];
+            let (mask, entry) = enter(node, &ray);
+            if mask != 0 {
+                // A shadow ray stops at any hit: no order to keep, no distance to drop by.
+                let n = children(node, mask, &entry, &mut kids, !ANY);
+                for &k in &kids[..n - 1] {
+                    stack.push(k);
+                }
+                current = kids[n - 1] as u32;
+                continue;
             }
         }
-    );
-    traverse_ray.tmax
+        // The nearest pending target the ray still reaches.
+        loop {
+            let Some(e) = stack.pop() else {
+                return ray.tmax;
+            };
+            if f32::from_bits((e >> 32) as u32) <= ray.tmax {
+                current = e as u32;
+                break;
+            }
+        }
+    }
 }
 
-/// obvhs's `CwBvh::ray_traverse_miss` with [`node_hits`]: true when no call of `hit_fn` (as
-/// in [`closest`]) returns a distance below `ray.tmax`; stops at the first that does.
+/// The closest hit's walk: calls `hit_fn(ray, primitive)` for each primitive in a leaf the
+/// ray enters before its current `tmax`, which shrinks to every closer distance `hit_fn`
+/// returns. Gives the closest such distance (`ray.tmax` when none).
 #[inline(always)]
-pub(super) fn misses<F: FnMut(&Ray, usize) -> f32>(bvh: &CwBvh, ray: Ray, mut hit_fn: F) -> bool {
-    let mut state = bvh.new_traversal(ray.direction);
-    let mut node;
-    let mut miss = true;
-    'outer: {
-        obvhs::traverse!(bvh, node, state, node_hits(node, &ray, state.oct_inv4), {
-            let t = hit_fn(&ray, state.primitive_id as usize);
-            if t < ray.tmax {
-                miss = false;
-                break 'outer;
-            }
-        });
-    }
-    miss
+pub(super) fn closest<F: FnMut(&Ray, usize) -> f32>(bvh: &CwBvh, ray: Ray, hit_fn: F) -> f32 {
+    walk::<false, F>(bvh, ray, hit_fn)
+}
+
+/// The shadow ray's walk: true when no call of `hit_fn` (as in [`closest`]) returns a
+/// distance below `ray.tmax`; stops at the first that does.
+#[inline(always)]
+pub(super) fn misses<F: FnMut(&Ray, usize) -> f32>(bvh: &CwBvh, ray: Ray, hit_fn: F) -> bool {
+    let tmax = ray.tmax;
+    walk::<true, F>(bvh, ray, hit_fn) >= tmax
 }
 
 #[cfg(test)]
@@ -159,7 +305,8 @@ mod tests {
         }
     }
 
-    /// A node with random children's quantised planes (min at most max) around `p`.
+    /// A node with random children's quantised planes (min at most max) around `p`, some
+    /// slots empty.
     fn node(c: &mut Cases) -> CwBvhNode {
         let mut n = CwBvhNode {
             p: Vec3::new(c.signed(), c.signed(), c.signed()) * 4.0,
@@ -169,7 +316,7 @@ mod tests {
             ..Default::default()
         };
         for i in 0..8 {
-            n.child_meta[i] = c.byte();
+            n.child_meta[i] = if c.byte() < 40 { 0 } else { c.byte() };
             for (lo, hi) in [
                 (&mut n.child_min_x, &mut n.child_max_x),
                 (&mut n.child_min_y, &mut n.child_max_y),
@@ -189,9 +336,23 @@ mod tests {
         (7 - oct) * 0x0101_0101
     }
 
-    /// The node test (the 8-lane one where the build has AVX2) gives obvhs's own hit masks.
+    /// obvhs's hit mask from the slots entered.
+    fn obvhs_mask(n: &CwBvhNode, mut slots: u32, inv: u32) -> u32 {
+        let (child_bits8, bit_index8) = n.get_child_and_index_bits(inv);
+        let mut hit_mask = 0;
+        while slots != 0 {
+            let shift = slots.trailing_zeros() * 8;
+            slots &= slots - 1;
+            let child_bits = ((child_bits8 >> shift) as u32) & 0xff;
+            hit_mask |= child_bits << (((bit_index8 >> shift) as u32) & 0xff);
+        }
+        hit_mask
+    }
+
+    /// The node test (the 8-lane one where the build has AVX2) enters the children obvhs's
+    /// test enters, and agrees with the one-slot-at-a-time test bit for bit.
     #[test]
-    fn node_test_gives_obvhs_hit_masks() {
+    fn node_test_enters_what_obvhs_enters() {
         let mut c = Cases(0x9e37_79b9_7f4a_7c15);
         let mut hits = 0;
         for _ in 0..20_000 {
@@ -208,11 +369,78 @@ mod tests {
             }
             let ray = Ray::new(o, d.normalize_or(Vec3A::X), 0.0, 1.0 + 30.0 * c.unit());
             let inv = oct_inv4(ray.direction);
-            let ours = node_hits(&n, &ray, inv);
-            assert_eq!(ours, n.intersect_ray(&ray, inv), "node {n:?} ray {ray:?}");
-            hits += u32::from(ours != 0);
+            let (mask, entry) = enter(&n, &ray);
+            let (scalar_mask, scalar_entry) = enter_scalar(&n, &ray);
+            assert_eq!(mask, scalar_mask, "node {n:?} ray {ray:?}");
+            for s in 0..8 {
+                if mask & (1 << s) != 0 {
+                    assert_eq!(entry[s].to_bits(), scalar_entry[s].to_bits());
+                    assert!(entry[s] >= NODE_EPSILON);
+                }
+            }
+            let expected = n.intersect_ray(&ray, inv);
+            assert_eq!(
+                obvhs_mask(&n, mask, inv),
+                expected,
+                "node {n:?} ray {ray:?}"
+            );
+            hits += u32::from(expected != 0);
         }
         // The cases must exercise hits, not only misses.
         assert!(hits > 500, "only {hits} of the cases hit a child");
+    }
+
+    /// On obvhs's own trees over random triangles the walks find obvhs's closest distance and
+    /// its shadow answer.
+    #[test]
+    fn walks_agree_with_obvhs_traversal() {
+        use obvhs::triangle::Triangle;
+        let mut c = Cases(0x2545_f491_4f6c_dd1d);
+        let tris: Vec<Triangle> = (0..3000)
+            .map(|_| {
+                let p = Vec3A::new(c.signed(), c.signed(), c.signed()) * 5.0;
+                let mut e = || Vec3A::new(c.signed(), c.signed(), c.signed()) * 0.4;
+                Triangle {
+                    v0: p,
+                    v1: p + e(),
+                    v2: p + e(),
+                }
+            })
+            .collect();
+        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &tris,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut std::time::Duration::default(),
+        );
+        let test = |r: &Ray, id: usize| {
+            let t = tris[bvh.primitive_indices[id] as usize].intersect(r);
+            if t < r.tmax {
+                t
+            } else {
+                f32::INFINITY
+            }
+        };
+        let mut hits = 0;
+        for i in 0..20_000 {
+            let o = Vec3A::new(c.signed(), c.signed(), c.signed()) * 7.0;
+            let d = Vec3A::new(c.signed(), c.signed(), c.signed()).normalize_or(Vec3A::Y);
+            let tmax = if i % 2 == 0 {
+                f32::INFINITY
+            } else {
+                8.0 * c.unit()
+            };
+            let ray = Ray::new(o, d, 0.0, tmax);
+            let mut expected = obvhs::ray::RayHit::none();
+            let found = bvh.ray_traverse(ray, &mut expected, test);
+            let ours = closest(&bvh, ray, test);
+            assert_eq!(ours < tmax, found, "ray {i}");
+            if found {
+                assert_eq!(ours, expected.t, "ray {i}");
+                hits += 1;
+            }
+            assert_eq!(misses(&bvh, ray, test), !found, "ray {i}");
+            assert_eq!(bvh.ray_traverse_miss(ray, test), !found, "ray {i}");
+        }
+        assert!(hits > 2000, "only {hits} hits");
     }
 }

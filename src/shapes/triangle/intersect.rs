@@ -4,7 +4,7 @@
 use super::TriangleMesh;
 use crate::geometry::{Ray, Vec3};
 use crate::shapes::gamma;
-use glam::{Vec3A, Vec3Swizzles};
+use glam::{Vec3A, Vec3Swizzles, Vec4};
 
 /// Where a ray meets a triangle: its parameter and barycentrics (p = b0 p0 + b1 p1 + b2 p2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -86,17 +86,24 @@ impl TriangleRay {
 }
 
 /// A triangle's vertices stored by coordinate (the x of all three, then the y, then the z),
-/// so that the watertight test's per-vertex steps run on all three vertices at once.
+/// so that the watertight test's per-vertex steps run on all three vertices at once. The
+/// fourth lane of each row holds a vertex's index in its mesh (as a float, exact below 2^24;
+/// -1 when unknown): a hit's shading normal and uvs are then read without the mesh's index
+/// list, a dependent load fewer. A float, not the index's bits, because the test's lane
+/// arithmetic runs over the fourth lane too, where bits read as denormals would be slow.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TriangleVerts {
-    xyz: [Vec3A; 3],
+    xyz: [Vec4; 3],
 }
+
+/// Indices from 2^24 on are not exact as floats: such a vertex's record says "unknown".
+const INDEX_LIMIT: u32 = 1 << 24;
 
 impl TriangleVerts {
     /// The record of a primitive that is not a triangle (NaN coordinates, which
     /// [`TriangleVerts::is_triangle`] tells apart).
     pub const NONE: Self = Self {
-        xyz: [Vec3A::NAN; 3],
+        xyz: [Vec4::NAN; 3],
     };
 
     /// False for [`TriangleVerts::NONE`] (and for a triangle with a NaN first x, which no ray
@@ -106,17 +113,33 @@ impl TriangleVerts {
         !self.xyz[0].x.is_nan()
     }
 
-    /// From the three vertex positions.
+    /// From the three vertex positions, their indices unknown.
     #[inline]
     pub fn new(p: &[Vec3; 3]) -> Self {
+        Self::with_indices(p, None)
+    }
+
+    /// From the three vertex positions and, if given, their indices in the mesh.
+    #[inline]
+    pub fn with_indices(p: &[Vec3; 3], indices: Option<[u32; 3]>) -> Self {
         let [a, b, c] = *p;
+        let w = match indices {
+            Some(i) if i.iter().all(|&k| k < INDEX_LIMIT) => i.map(|k| k as f32),
+            _ => [-1.0; 3],
+        };
         Self {
             xyz: [
-                Vec3A::new(a.x, b.x, c.x),
-                Vec3A::new(a.y, b.y, c.y),
-                Vec3A::new(a.z, b.z, c.z),
+                Vec4::new(a.x, b.x, c.x, w[0]),
+                Vec4::new(a.y, b.y, c.y, w[1]),
+                Vec4::new(a.z, b.z, c.z, w[2]),
             ],
         }
+    }
+
+    /// Row `k` (the vertices' coordinate `k`) as the test computes on it.
+    #[inline(always)]
+    fn row(&self, k: usize) -> Vec3A {
+        Vec3A::from_vec4(self.xyz[k])
     }
 
     /// Vertex `i`.
@@ -129,6 +152,13 @@ impl TriangleVerts {
     #[inline]
     pub fn vertices(&self) -> [Vec3; 3] {
         [self.vertex(0), self.vertex(1), self.vertex(2)]
+    }
+
+    /// The three vertices' indices in their mesh, when the record holds them.
+    #[inline]
+    pub fn indices(&self) -> Option<[usize; 3]> {
+        let w = [self.xyz[0].w, self.xyz[1].w, self.xyz[2].w];
+        (w[0] >= 0.0).then(|| w.map(|k| k as usize))
     }
 }
 
@@ -169,9 +199,9 @@ fn intersect_permuted<const KX: usize, const KY: usize, const KZ: usize>(
 ) -> Option<TriangleHit> {
     debug_assert_eq!((r.kx, r.ky, r.kz), (KX, KY, KZ));
     // Translate to the ray origin and permute.
-    let mut xs = v.xyz[KX] - Vec3A::splat(r.o[KX]);
-    let mut ys = v.xyz[KY] - Vec3A::splat(r.o[KY]);
-    let zs = v.xyz[KZ] - Vec3A::splat(r.o[KZ]);
+    let mut xs = v.row(KX) - Vec3A::splat(r.o[KX]);
+    let mut ys = v.row(KY) - Vec3A::splat(r.o[KY]);
+    let zs = v.row(KZ) - Vec3A::splat(r.o[KZ]);
 
     // Shear so that the ray direction becomes +z.
     xs += Vec3A::splat(r.sx) * zs;

@@ -66,7 +66,7 @@ impl TriangleMesh {
 
     /// Vertex indices of triangle `tri`.
     #[inline]
-    fn vertex_indices(&self, tri: usize) -> [usize; 3] {
+    pub fn vertex_indices(&self, tri: usize) -> [usize; 3] {
         let i = &self.indices[3 * tri..3 * tri + 3];
         [i[0] as usize, i[1] as usize, i[2] as usize]
     }
@@ -78,15 +78,43 @@ impl TriangleMesh {
         [self.positions[a], self.positions[b], self.positions[c]]
     }
 
-    /// Texture coordinates of triangle `tri` (pbrt-v3's defaults (0,0), (1,0), (1,1)).
+    /// Texture coordinates of the triangle of vertices `at` (pbrt-v3's defaults (0,0),
+    /// (1,0), (1,1)).
     #[inline]
-    fn uvs_of(&self, tri: usize) -> [Vec2; 3] {
+    fn uvs_at(&self, at: &Corners) -> [Vec2; 3] {
         match &self.uvs {
             Some(uv) => {
-                let [a, b, c] = self.vertex_indices(tri);
+                let [a, b, c] = at.indices(self);
                 [uv[a], uv[b], uv[c]]
             }
             None => [Vec2::ZERO, Vec2::new(1.0, 0.0), Vec2::ONE],
+        }
+    }
+}
+
+/// A triangle of a mesh, with its vertices' indices when the caller already holds them
+/// (from the traversal's record, [`TriangleVerts::indices`]): read from the mesh otherwise.
+#[derive(Clone, Copy, Debug)]
+pub struct Corners {
+    /// The triangle's index in its mesh.
+    pub tri: usize,
+    /// Its vertices' indices, if known.
+    pub known: Option<[usize; 3]>,
+}
+
+impl Corners {
+    /// Triangle `tri`, its vertices' indices to be read from the mesh.
+    #[inline]
+    pub fn of(tri: usize) -> Self {
+        Self { tri, known: None }
+    }
+
+    /// The vertices' indices.
+    #[inline]
+    fn indices(&self, mesh: &TriangleMesh) -> [usize; 3] {
+        match self.known {
+            Some(i) => i,
+            None => mesh.vertex_indices(self.tri),
         }
     }
 }
@@ -119,8 +147,14 @@ fn triangle_dpduv(p: &[Vec3; 3], uv: &[Vec2; 3]) -> (Vec3, Vec3) {
 /// the interpolation does not vanish.
 #[inline]
 pub fn shading_normal(mesh: &TriangleMesh, tri: usize, b: [f32; 3]) -> Option<Vec3> {
+    shading_normal_at(mesh, &Corners::of(tri), b)
+}
+
+/// [`shading_normal`] of the triangle of vertices `at`.
+#[inline]
+fn shading_normal_at(mesh: &TriangleMesh, at: &Corners, b: [f32; 3]) -> Option<Vec3> {
     let normals = mesh.normals.as_ref()?;
-    let [a, bb, c] = mesh.vertex_indices(tri);
+    let [a, bb, c] = at.indices(mesh);
     let ns = b[0] * normals[a] + b[1] * normals[bb] + b[2] * normals[c];
     if ns.length_squared() > 0.0 {
         Some(ns.normalize())
@@ -138,27 +172,28 @@ pub fn triangle_interaction(
     ray: &Ray,
     hit: &TriangleHit,
 ) -> SurfaceInteraction {
-    triangle_interaction_at(mesh, tri, mesh.vertices(tri), ray, hit)
+    triangle_interaction_at(mesh, &Corners::of(tri), mesh.vertices(tri), ray, hit)
 }
 
 /// [`triangle_interaction`] with the triangle's vertex positions `p` given (a copy the caller
-/// already holds): a mesh without normals or uvs is then not read past its header.
+/// already holds), and its vertices' indices if known: a mesh without normals or uvs is then
+/// not read past its header, one with them not in its index list.
 #[inline]
 pub fn triangle_interaction_at(
     mesh: &TriangleMesh,
-    tri: usize,
+    at: &Corners,
     p: [Vec3; 3],
     ray: &Ray,
     hit: &TriangleHit,
 ) -> SurfaceInteraction {
-    let uv = mesh.uvs_of(tri);
+    let uv = mesh.uvs_at(at);
     let (b0, b1, b2) = (hit.b0, hit.b1, hit.b2);
     let (dpdu, dpdv) = triangle_dpduv(&p, &uv);
     let p_hit = b0 * p[0] + b1 * p[1] + b2 * p[2];
     let uv_hit = b0 * uv[0] + b1 * uv[1] + b2 * uv[2];
     let n = (p[0] - p[2]).cross(p[1] - p[2]).normalize();
     let (n, shading_n, shading_dpdu, shading_dpdv) =
-        shading_geometry(mesh, tri, [b0, b1, b2], n, dpdu, dpdv);
+        shading_geometry(mesh, at, [b0, b1, b2], n, dpdu, dpdv);
     SurfaceInteraction {
         p: p_hit,
         n,
@@ -185,14 +220,14 @@ pub fn triangle_interaction_at(
 #[inline]
 fn shading_geometry(
     mesh: &TriangleMesh,
-    tri: usize,
+    at: &Corners,
     b: [f32; 3],
     n: Vec3,
     dpdu: Vec3,
     dpdv: Vec3,
 ) -> (Vec3, Vec3, Vec3, Vec3) {
     if mesh.normals.is_some() {
-        let ns = shading_normal(mesh, tri, b).unwrap_or(n);
+        let ns = shading_normal_at(mesh, at, b).unwrap_or(n);
         let mut ss = dpdu.normalize();
         let mut ts = ss.cross(ns);
         if ts.length_squared() > 0.0 {
@@ -228,8 +263,9 @@ pub fn triangle_crossing(
     let n = (p[0] - p[2]).cross(p[1] - p[2]).normalize();
     let n = if mesh.normals.is_some() {
         // The orientation follows the shading frame, which needs the tangents.
-        let (dpdu, dpdv) = triangle_dpduv(&p, &mesh.uvs_of(tri));
-        shading_geometry(mesh, tri, [hit.b0, hit.b1, hit.b2], n, dpdu, dpdv).0
+        let at = Corners::of(tri);
+        let (dpdu, dpdv) = triangle_dpduv(&p, &mesh.uvs_at(&at));
+        shading_geometry(mesh, &at, [hit.b0, hit.b1, hit.b2], n, dpdu, dpdv).0
     } else if mesh.reverse_orientation ^ mesh.transform_swaps_handedness {
         -n
     } else {
