@@ -4,8 +4,9 @@
 
 use super::light_sample::{next_event, LastScatter};
 use super::{subsurface, Radiance, MAX_PASS_THROUGH};
+use crate::bsdf::Bsdf;
 use crate::first_hit::FirstHitProbe;
-use crate::geometry::{Ray, RayDifferentials, Spectrum};
+use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -49,9 +50,12 @@ pub(super) fn path_li(
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
     let mut probe = FirstHitProbe::default();
+    // One interaction and one BSDF for the whole path, refilled in place at each hit.
+    let mut si = SurfaceInteraction::default();
+    let mut bsdf = Bsdf::empty();
     loop {
         rays += 1;
-        let Some(hit) = scene.intersect(&ray) else {
+        let Some(surface) = scene.intersect_into(&ray, &mut si) else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
@@ -61,14 +65,13 @@ pub(super) fn path_li(
             }
             break;
         };
-        let mut si = hit.si;
         // Only the camera ray has differentials (pbrt-v3's path integrator spawns every later
         // ray, and the one through an interface, without them).
         if let Some(d) = diff.take() {
             si.compute_differentials(d);
         }
         probe.travel(ray.o, si.p);
-        if let Some(li) = hit.surface.area_light {
+        if let Some(li) = surface.area_light {
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
             if le != Spectrum::ZERO {
@@ -77,7 +80,7 @@ pub(super) fn path_li(
                 });
             }
         }
-        let Some(material) = hit.surface.material else {
+        let Some(material) = surface.material else {
             // An interface between media: continue in the same direction, same depth.
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
@@ -91,8 +94,8 @@ pub(super) fn path_li(
         }
         let material_index = material;
         let material = &scene.materials[material as usize];
-        let si = material.shading(&si);
-        let bsdf = material.bsdf(&si);
+        material.shade(&mut si);
+        material.bsdf_into(&si, &mut bsdf);
         probe.surface(&si, &bsdf);
         last.ctx = None;
         if have_lights && bsdf.has_non_specular() {

@@ -154,6 +154,16 @@ impl Scene {
         })
     }
 
+    /// [`Scene::intersect`] with the interaction written into `si` (left as it was on a miss):
+    /// what the ray hit. An integrator keeps one interaction for its path, where a returned
+    /// hit was copied on its way (about 180 bytes, several times a hit).
+    #[inline]
+    pub fn intersect_into(&self, ray: &Ray, si: &mut SurfaceInteraction) -> Option<Surface> {
+        let hit = self.accel.intersect(ray, f32::INFINITY)?;
+        *si = self.accel.interaction(ray, &hit);
+        Some(self.surfaces[hit.prim.surface as usize])
+    }
+
     /// Whether the segment from `si` to `target` is blocked.
     #[inline]
     pub fn occluded(&self, si: &SurfaceInteraction, target: Vec3) -> bool {
