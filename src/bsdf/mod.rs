@@ -263,17 +263,32 @@ impl Bsdf {
         let mut pdf = s.pdf;
         let mut f = lobe.scale * s.f;
         if !specular {
-            for (i, other) in self.lobes().iter().enumerate() {
-                if i != comp {
-                    pdf += other.bxdf.pdf(wo, s.wi);
-                }
-            }
             // As pbrt-v3, with one lobe too: a direction on the other side of the geometric
             // surface than a reflection lobe allows gives nothing (it applied only with several
             // lobes, so a bumped or smooth-shaded matte lit the sky below its surface: +0.45%
             // on scenes/pbrt-v3/bump-map.pbrt's floor under the sky alone).
             let reflect = wi_world.dot(self.ng) * wo_world.dot(self.ng) > 0.0;
-            f = self.sum_f(wo, s.wi, reflect);
+            let wanted = if reflect {
+                BxdfType::REFLECTION
+            } else {
+                BxdfType::TRANSMISSION
+            };
+            // `sum_f`'s sum in its order, where the sampled lobe's value is the sample's own
+            // when that is its `f` (not evaluated twice: a microfacet lobe's costs).
+            let reuse = lobe.bxdf.sample_is_f();
+            f = Spectrum::ZERO;
+            for (i, other) in self.lobes().iter().enumerate() {
+                if i != comp {
+                    pdf += other.bxdf.pdf(wo, s.wi);
+                }
+                if other.bxdf.kind().contains(wanted) {
+                    f += if i == comp && reuse {
+                        lobe.scale * s.f
+                    } else {
+                        other.scale * other.bxdf.f(wo, s.wi)
+                    };
+                }
+            }
         }
         if n > 1 {
             pdf /= n as f32;
