@@ -80,7 +80,7 @@ impl Frame {
 }
 
 /// Where a ray meets a surface, with pbrt's differential geometry.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct SurfaceInteraction {
     /// The hit point.
     pub p: Vec3,

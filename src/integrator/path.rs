@@ -6,7 +6,7 @@ use super::light_sample::{next_event, LastScatter};
 use super::{subsurface, Radiance, MAX_PASS_THROUGH};
 use crate::bsdf::Bsdf;
 use crate::first_hit::FirstHitProbe;
-use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
+use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -50,12 +50,14 @@ pub(super) fn path_li(
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
     let mut probe = FirstHitProbe::default();
-    // One interaction and one BSDF for the whole path, refilled in place at each hit.
-    let mut si = SurfaceInteraction::default();
+    // One BSDF for the whole path, refilled in place at each hit.
     let mut bsdf = Bsdf::empty();
     loop {
         rays += 1;
-        let Some(surface) = scene.intersect_into(&ray, &mut si) else {
+        // Borrowed where it was returned: moving it out copied it, reading back the stores
+        // just made in other widths (a stalled load).
+        let found = scene.closest_hit(&ray);
+        let Some(hit) = &found else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
@@ -65,6 +67,8 @@ pub(super) fn path_li(
             }
             break;
         };
+        let surface = scene.surface_of(hit);
+        let mut si = scene.interaction(&ray, hit);
         // Only the camera ray has differentials (pbrt-v3's path integrator spawns every later
         // ray, and the one through an interface, without them).
         if let Some(d) = diff.take() {
