@@ -153,9 +153,9 @@ impl Bsdf {
     /// The lobes.
     #[inline]
     pub fn lobes(&self) -> &[Lobe] {
-        let len = self.len.min(MAX_LOBES);
+        debug_assert!(self.len <= MAX_LOBES);
         // SAFETY: as in `scale_lobes`: the first `len` slots are initialised.
-        unsafe { std::slice::from_raw_parts(self.lobes.as_ptr().cast::<Lobe>(), len) }
+        unsafe { std::slice::from_raw_parts(self.lobes.as_ptr().cast::<Lobe>(), self.len) }
     }
 
     /// Number of lobes.
