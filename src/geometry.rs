@@ -53,6 +53,7 @@ impl Frame {
 
     /// A frame with z = unit `n` and x as close as possible to `s` (Gram-Schmidt); falls back to
     /// [`Frame::from_z`] when `s` is parallel to `n` or degenerate.
+    #[inline]
     pub fn from_xz(s: Vec3, n: Vec3) -> Self {
         let s = (s - n * n.dot(s)).normalize_or_zero();
         if s == Vec3::ZERO || !s.is_finite() {

@@ -160,6 +160,22 @@ impl Bxdf {
         }
     }
 
+    /// Whether [`Bxdf::sample_f`]'s value is [`Bxdf::f`] of the sampled direction, bit for bit
+    /// (so [`super::Bsdf::sample_f`] need not evaluate it again).
+    #[inline]
+    pub(crate) fn sample_is_f(&self) -> bool {
+        matches!(
+            self,
+            Bxdf::Lambertian { .. }
+                | Bxdf::OrenNayar { .. }
+                | Bxdf::BssrdfAdapter { .. }
+                | Bxdf::LambertianTransmission { .. }
+                | Bxdf::MicrofacetReflection { .. }
+                | Bxdf::MicrofacetTransmission { .. }
+                | Bxdf::FresnelBlend { .. }
+        )
+    }
+
     /// Whether the lobe is a delta distribution.
     #[inline]
     pub fn is_specular(&self) -> bool {

@@ -5,12 +5,17 @@
 //! The lobes of pbrt-v3's Disney BSDF and of its hair are in [`disney`] and [`hair`]; what
 //! every lobe shares (its kind, its sample, the microfacet steps) is a leaf below them all.
 //!
+//! The lobe slots beyond the ones a material adds are never written: building a BSDF costs
+//! what its material needs, not its 0.7 kB (docs/BENCHMARKS.md, "The interiors: where the
+//! time goes").
+//!
 //! Lobes work in the local shading frame (z = shading normal); [`Bsdf`] converts from world
 //! space and decides reflection against transmission with the geometric normal, as pbrt-v3 does.
 //! Where pbrt-v3 would produce NaN or infinity (grazing or degenerate directions), these return
 //! zero, or no sample.
 
 use crate::geometry::{Frame, Spectrum, SurfaceInteraction, Vec2, Vec3};
+use std::mem::MaybeUninit;
 
 mod bxdf;
 pub mod disney;
@@ -33,11 +38,6 @@ pub struct Lobe {
     pub scale: Spectrum,
 }
 
-const EMPTY_LOBE: Lobe = Lobe {
-    bxdf: Bxdf::Lambertian { r: Spectrum::ZERO },
-    scale: Spectrum::ZERO,
-};
-
 /// A sampled direction from a [`Bsdf`], in world space.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
@@ -53,13 +53,26 @@ pub struct BsdfSample {
 
 /// pbrt-v3's BSDF: lobes in a shading frame, with the geometric normal and the relative index
 /// of refraction (for Russian roulette's radiance scaling through refraction).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Bsdf {
     frame: Frame,
     ng: Vec3,
     eta: f32,
     len: usize,
-    lobes: [Lobe; MAX_LOBES],
+    // Only the first `len` slots are initialised (every write goes through `add_scaled`, the
+    // only reads through `lobes`): a hit pays for the lobes its material adds, not for eight.
+    lobes: [MaybeUninit<Lobe>; MAX_LOBES],
+}
+
+impl std::fmt::Debug for Bsdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bsdf")
+            .field("frame", &self.frame)
+            .field("ng", &self.ng)
+            .field("eta", &self.eta)
+            .field("lobes", &self.lobes())
+            .finish()
+    }
 }
 
 impl Bsdf {
@@ -79,13 +92,21 @@ impl Bsdf {
             ng,
             eta,
             len: 0,
-            lobes: [EMPTY_LOBE; MAX_LOBES],
+            lobes: [MaybeUninit::uninit(); MAX_LOBES],
         }
     }
 
+    /// An empty BSDF with the identity frame, for a caller to fill in place with
+    /// [`Bsdf::reset`] (or [`crate::material::Material::bsdf_into`]) at each hit: returning a
+    /// BSDF by value copies it.
+    #[inline]
+    pub fn empty() -> Self {
+        Self::from_frame(Frame::from_z(Vec3::Z), Vec3::Z, 1.0)
+    }
+
     /// Makes this BSDF [`Bsdf::new`]'s for `si` and `eta`, in place: the lobe slots are left
-    /// as they are (only the first `len` are read), so that a BSDF kept from one path to the
-    /// next is refilled without rewriting its 0.7 kB.
+    /// as they are (only the first `len` are read), so that a BSDF kept from one hit to the
+    /// next is refilled without moving its 0.7 kB.
     #[inline]
     pub fn reset(&mut self, si: &SurfaceInteraction, eta: f32) {
         self.frame = Frame::from_xz(si.shading_dpdu, si.shading_n);
@@ -106,7 +127,7 @@ impl Bsdf {
         if self.len == MAX_LOBES {
             return false;
         }
-        self.lobes[self.len] = Lobe { bxdf, scale };
+        self.lobes[self.len] = MaybeUninit::new(Lobe { bxdf, scale });
         self.len += 1;
         true
     }
@@ -119,14 +140,22 @@ impl Bsdf {
 
     /// Multiplies every lobe's weight by `s`.
     pub fn scale_lobes(&mut self, s: Spectrum) {
-        for l in &mut self.lobes[..self.len] {
+        let len = self.len;
+        // SAFETY: the first `len` slots were written by `add_scaled` (`len` grows only there,
+        // after the write, and never past MAX_LOBES), and MaybeUninit<Lobe> has Lobe's layout.
+        let lobes =
+            unsafe { std::slice::from_raw_parts_mut(self.lobes.as_mut_ptr().cast::<Lobe>(), len) };
+        for l in lobes {
             l.scale *= s;
         }
     }
 
     /// The lobes.
+    #[inline]
     pub fn lobes(&self) -> &[Lobe] {
-        &self.lobes[..self.len]
+        debug_assert!(self.len <= MAX_LOBES);
+        // SAFETY: as in `scale_lobes`: the first `len` slots are initialised.
+        unsafe { std::slice::from_raw_parts(self.lobes.as_ptr().cast::<Lobe>(), self.len) }
     }
 
     /// Number of lobes.
@@ -227,24 +256,39 @@ impl Bsdf {
         if wo.z == 0.0 {
             return None;
         }
-        let lobe = &self.lobes[comp];
+        let lobe = &self.lobes()[comp];
         let s = lobe.bxdf.sample_f(wo, u)?;
         let wi_world = self.frame.from_local(s.wi);
         let specular = s.kind.contains(BxdfType::SPECULAR);
         let mut pdf = s.pdf;
         let mut f = lobe.scale * s.f;
         if !specular {
-            for (i, other) in self.lobes().iter().enumerate() {
-                if i != comp {
-                    pdf += other.bxdf.pdf(wo, s.wi);
-                }
-            }
             // As pbrt-v3, with one lobe too: a direction on the other side of the geometric
             // surface than a reflection lobe allows gives nothing (it applied only with several
             // lobes, so a bumped or smooth-shaded matte lit the sky below its surface: +0.45%
             // on scenes/pbrt-v3/bump-map.pbrt's floor under the sky alone).
             let reflect = wi_world.dot(self.ng) * wo_world.dot(self.ng) > 0.0;
-            f = self.sum_f(wo, s.wi, reflect);
+            let wanted = if reflect {
+                BxdfType::REFLECTION
+            } else {
+                BxdfType::TRANSMISSION
+            };
+            // `sum_f`'s sum in its order, where the sampled lobe's value is the sample's own
+            // when that is its `f` (not evaluated twice: a microfacet lobe's costs).
+            let reuse = lobe.bxdf.sample_is_f();
+            f = Spectrum::ZERO;
+            for (i, other) in self.lobes().iter().enumerate() {
+                if i != comp {
+                    pdf += other.bxdf.pdf(wo, s.wi);
+                }
+                if other.bxdf.kind().contains(wanted) {
+                    f += if i == comp && reuse {
+                        lobe.scale * s.f
+                    } else {
+                        other.scale * other.bxdf.f(wo, s.wi)
+                    };
+                }
+            }
         }
         if n > 1 {
             pdf /= n as f32;

@@ -420,3 +420,78 @@ fn world_frame_follows_the_shading_tangent() {
     let along_v = b.f(wo, Vec3::new(0.0, 1.0, 0.2).normalize());
     assert!(along_u.x > 10.0 * along_v.x, "{along_u} {along_v}");
 }
+
+#[test]
+fn lobes_said_to_sample_their_value_do_so_bit_for_bit() {
+    // `Bsdf::sample_f` takes such a lobe's value from its sample instead of evaluating it
+    // again: the images stay the same only if the two agree exactly.
+    let adapter = Bxdf::BssrdfAdapter {
+        eta: 1.33,
+        scale: crate::bssrdf::adapter::adapter_scale(1.33),
+    };
+    let mut rng = Rng::new(11);
+    let mut kinds = 0;
+    for (name, bxdf) in non_specular_lobes()
+        .into_iter()
+        .chain([("adapter", adapter)])
+    {
+        if !bxdf.sample_is_f() {
+            continue;
+        }
+        kinds += 1;
+        let mut sampled = 0;
+        for wo in test_directions() {
+            for _ in 0..2000 {
+                if let Some(s) = bxdf.sample_f(wo, rng.next_2d()) {
+                    assert_eq!(s.f, bxdf.f(wo, s.wi), "{name}: wo {wo} wi {}", s.wi);
+                    sampled += 1;
+                }
+            }
+        }
+        assert!(sampled > 1000, "{name}: {sampled} samples");
+    }
+    assert_eq!(kinds, 9);
+}
+
+#[test]
+fn a_refilled_bsdf_is_a_fresh_one() {
+    let si = SurfaceInteraction {
+        p: Vec3::ZERO,
+        n: Vec3::Z,
+        uv: Vec2::ZERO,
+        dpdu: Vec3::X,
+        dpdv: Vec3::Y,
+        shading_n: Vec3::new(0.1, 0.0, 1.0).normalize(),
+        shading_dpdu: Vec3::X,
+        shading_dpdv: Vec3::Y,
+        dndu: Vec3::ZERO,
+        dndv: Vec3::ZERO,
+        wo: Vec3::Z,
+        time: 0.0,
+        p_error: 0.0,
+        diff: Default::default(),
+    };
+    let lobes = non_specular_lobes();
+    // Three lobes, then refilled with two: the third slot still holds a lobe, never read.
+    let mut kept = local_bsdf(&[lobes[2].1, lobes[5].1, lobes[6].1], 1.5);
+    kept.reset(&si, 1.0);
+    assert_eq!(kept.num_lobes(), 0);
+    assert!(kept.sample_f(Vec3::Z, Vec2::splat(0.5), 0.5).is_none());
+    let mut fresh = Bsdf::new(&si, 1.0);
+    for b in [&mut kept, &mut fresh] {
+        b.add(lobes[0].1);
+        b.add_scaled(lobes[3].1, Spectrum::new(0.2, 0.5, 0.7));
+    }
+    assert_eq!(kept.lobes(), fresh.lobes());
+    assert_eq!(kept.eta(), 1.0);
+    let mut rng = Rng::new(5);
+    for wo in test_directions() {
+        for _ in 0..500 {
+            let (u, u_lobe, wi) = (rng.next_2d(), rng.next_f32(), test_directions()[1]);
+            let (a, b) = (kept.sample_f(wo, u, u_lobe), fresh.sample_f(wo, u, u_lobe));
+            assert_eq!(a.map(|s| (s.wi, s.f, s.pdf)), b.map(|s| (s.wi, s.f, s.pdf)));
+            assert_eq!(kept.f(wo, wi), fresh.f(wo, wi));
+            assert_eq!(kept.pdf(wo, wi), fresh.pdf(wo, wi));
+        }
+    }
+}

@@ -3,6 +3,7 @@
 
 use super::light_sample::sample_light;
 use super::{DirectStrategy, MAX_PASS_THROUGH};
+use crate::bsdf::Bsdf;
 use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, RayDifferentials, Spectrum, SurfaceInteraction};
 use crate::lightbvh::LightContext;
@@ -52,10 +53,11 @@ pub(super) fn direct_li(
         return l;
     };
     let material = &scene.materials[material as usize];
-    let si = material.shading(&si);
+    material.shade(&mut si);
     // pbrt-v3's DirectLightingIntegrator asks for separate lobes (a glass's reflection and
     // transmission apart), and follows each.
-    let bsdf = material.bsdf_with(&si, false);
+    let mut bsdf = Bsdf::empty();
+    material.bsdf_into_with(&si, false, &mut bsdf);
     tally.probe.surface(&si, &bsdf);
     if bsdf.has_non_specular() && !scene.lights.is_empty() {
         match strategy {

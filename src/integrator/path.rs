@@ -4,6 +4,7 @@
 
 use super::light_sample::{next_event, LastScatter};
 use super::{subsurface, Radiance, MAX_PASS_THROUGH};
+use crate::bsdf::Bsdf;
 use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::lightbvh::LightContext;
@@ -49,9 +50,14 @@ pub(super) fn path_li(
     let mut pass_through = 0u32;
     let have_lights = !scene.lights.is_empty();
     let mut probe = FirstHitProbe::default();
+    // One BSDF for the whole path, refilled in place at each hit.
+    let mut bsdf = Bsdf::empty();
     loop {
         rays += 1;
-        let Some(hit) = scene.intersect(&ray) else {
+        // Borrowed where it was returned: moving it out copied it, reading back the stores
+        // just made in other widths (a stalled load).
+        let found = scene.closest_hit(&ray);
+        let Some(hit) = &found else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
@@ -61,14 +67,15 @@ pub(super) fn path_li(
             }
             break;
         };
-        let mut si = hit.si;
+        let surface = scene.surface_of(hit);
+        let mut si = scene.interaction(&ray, hit);
         // Only the camera ray has differentials (pbrt-v3's path integrator spawns every later
         // ray, and the one through an interface, without them).
         if let Some(d) = diff.take() {
             si.compute_differentials(d);
         }
         probe.travel(ray.o, si.p);
-        if let Some(li) = hit.surface.area_light {
+        if let Some(li) = surface.area_light {
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
             if le != Spectrum::ZERO {
@@ -77,7 +84,7 @@ pub(super) fn path_li(
                 });
             }
         }
-        let Some(material) = hit.surface.material else {
+        let Some(material) = surface.material else {
             // An interface between media: continue in the same direction, same depth.
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
@@ -91,8 +98,8 @@ pub(super) fn path_li(
         }
         let material_index = material;
         let material = &scene.materials[material as usize];
-        let si = material.shading(&si);
-        let bsdf = material.bsdf(&si);
+        material.shade(&mut si);
+        material.bsdf_into(&si, &mut bsdf);
         probe.surface(&si, &bsdf);
         last.ctx = None;
         if have_lights && bsdf.has_non_specular() {

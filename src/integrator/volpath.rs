@@ -440,6 +440,8 @@ pub(super) fn volpath_li(
     };
     let mut bounces = 0u32;
     let mut pass_through = 0u32;
+    // One BSDF for the whole path, refilled in place at each surface.
+    let mut bsdf = Bsdf::empty();
     loop {
         rays += 1;
         let hit = intersect(scene, &mr.ray, f32::INFINITY);
@@ -530,8 +532,8 @@ pub(super) fn volpath_li(
             };
             let material_index = material;
             let material = &scene.materials[material as usize];
-            let si = material.shading(&si);
-            let bsdf = material.bsdf(&si);
+            material.shade(&mut si);
+            material.bsdf_into(&si, &mut bsdf);
             probe.surface(&si, &bsdf);
             let v = Vertex::Surface {
                 si: &si,

@@ -4,6 +4,7 @@
 //! through them (docs/light-transport.md).
 
 use super::direct::{first_surface, follow_specular_lobes, Tally};
+use crate::bsdf::Bsdf;
 use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::scene::Scene;
 use crate::stream::SampleStream;
@@ -40,9 +41,10 @@ pub fn whitted_li(
         return l;
     };
     let material = &scene.materials[material as usize];
-    let si = material.shading(&si);
+    material.shade(&mut si);
     // Separate lobes (a glass's reflection and transmission apart), as pbrt-v3's Whitted.
-    let bsdf = material.bsdf_with(&si, false);
+    let mut bsdf = Bsdf::empty();
+    material.bsdf_into_with(&si, false, &mut bsdf);
     tally.probe.surface(&si, &bsdf);
     // A purely specular BSDF is black to every light sample: pbrt-v3 draws them for nothing.
     if bsdf.has_non_specular() {

@@ -119,6 +119,17 @@ impl Material {
         }
     }
 
+    /// [`Material::shading`] in place: `si` is left as it is unless the material bumps it
+    /// (an interaction is about 180 bytes, and each hit of a path copied it).
+    #[inline]
+    pub fn shade(&self, si: &mut SurfaceInteraction) {
+        match self {
+            Material::Bumped { map, .. } => *si = crate::bump::bump(map, si),
+            Material::Mix { materials, .. } => materials[0].shade(si),
+            _ => {}
+        }
+    }
+
     /// The BSSRDF at (shaded) hit `si`, for a subsurface material (bumped or not); `None`
     /// otherwise. A mix gives none: pbrt-v3's mix leaves its first material's BSSRDF, whose
     /// probe rays then look for that material and never find the mix, so its paths end.
@@ -152,8 +163,20 @@ impl Material {
     /// BSDFs from path to path and refill them in place.
     #[inline]
     pub fn bsdf_into(&self, si: &SurfaceInteraction, b: &mut Bsdf) {
+        self.bsdf_into_with(si, true, b);
+    }
+
+    /// [`Material::bsdf_with`] written into `b` (whatever it held): an integrator keeps one
+    /// BSDF ([`Bsdf::empty`]) and refills it at each hit, where returning one copies it.
+    #[inline]
+    pub fn bsdf_into_with(
+        &self,
+        si: &SurfaceInteraction,
+        allow_multiple_lobes: bool,
+        b: &mut Bsdf,
+    ) {
         b.reset(si, 1.0);
-        self.add_lobes(si, true, b, Spectrum::ONE, true);
+        self.add_lobes(si, allow_multiple_lobes, b, Spectrum::ONE, true);
     }
 
     /// Adds this material's lobes to `b`, each weighted by `scale`; `first` (the material that

@@ -470,6 +470,12 @@ fn bsdf_into_a_used_bsdf_is_bsdf() {
         let want = m.bsdf(&si());
         assert_eq!(b.lobes(), want.lobes(), "{name}");
         assert_eq!(b.eta(), want.eta(), "{name}");
+        // And with separate lobes, as directlighting and whitted refill theirs.
+        let mut single = m.bsdf(&other);
+        m.bsdf_into_with(&si(), false, &mut single);
+        let want_single = m.bsdf_with(&si(), false);
+        assert_eq!(single.lobes(), want_single.lobes(), "{name}");
+        assert_eq!(single.eta(), want_single.eta(), "{name}");
         for wo in test_directions() {
             for wi in test_directions() {
                 let (w, x) = (want.frame().from_local(wo), want.frame().from_local(wi));
@@ -478,4 +484,41 @@ fn bsdf_into_a_used_bsdf_is_bsdf() {
             }
         }
     }
+}
+
+/// `shade` in place is `shading`: a bumped material, a mix whose first material is bumped, and
+/// materials it leaves alone.
+#[test]
+fn shade_in_place_is_shading() {
+    let (m, _) = build(&format!(
+        r#"Texture "b" "float" "fbm"
+           MakeNamedMaterial "bumped" "string type" "matte" "texture bumpmap" "b"
+           MakeNamedMaterial "plain" "string type" "plastic"
+           NamedMaterial "bumped"
+           {SHAPE}
+           Material "mix" "string namedmaterial1" "bumped" "string namedmaterial2" "plain"
+           {SHAPE}
+           NamedMaterial "plain"
+           {SHAPE}"#
+    ));
+    let fields = |s: &SurfaceInteraction| {
+        let shading = (s.shading_n, s.shading_dpdu, s.shading_dpdv);
+        (s.p, s.n, s.dpdu, s.dpdv, shading, s.wo, s.uv)
+    };
+    let (mut moved, mut kept) = (0, 0);
+    for (i, mat) in m.iter().enumerate() {
+        let want = mat.shading(&si());
+        let mut got = si();
+        mat.shade(&mut got);
+        assert_eq!(fields(&got), fields(&want), "material {i}: {mat:?}");
+        if got.shading_n == si().shading_n {
+            kept += 1;
+        } else {
+            moved += 1;
+        }
+    }
+    assert!(
+        moved >= 2 && kept >= 1,
+        "{moved} bumped, {kept} not, of {m:?}"
+    );
 }

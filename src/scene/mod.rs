@@ -1,7 +1,7 @@
 //! The renderable scene, built once from a [`SceneDescription`]: camera, film settings,
 //! acceleration structure, lights, materials, and which dimensions the rendering space needs.
 
-use crate::accel::{Accel, PrimKind};
+use crate::accel::{Accel, Hit, PrimKind};
 use crate::camera::Camera;
 use crate::film::FilmSettings;
 use crate::geometry::{Ray, SurfaceInteraction, Vec3};
@@ -152,6 +152,26 @@ impl Scene {
             si,
             surface: self.surfaces[hit.prim.surface as usize],
         })
+    }
+
+    /// The closest hit along the ray, its interaction not made yet ([`Scene::interaction`]):
+    /// an integrator binds that to a fresh local, which the call fills in place, where a hit
+    /// returned with its interaction was copied on its way (about 180 bytes).
+    #[inline]
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.accel.intersect(ray, f32::INFINITY)
+    }
+
+    /// The world-space interaction of `hit` on `ray` (from [`Scene::closest_hit`]).
+    #[inline]
+    pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        self.accel.interaction(ray, hit)
+    }
+
+    /// The surface `hit` found.
+    #[inline]
+    pub fn surface_of(&self, hit: &Hit) -> Surface {
+        self.surfaces[hit.prim.surface as usize]
     }
 
     /// Whether the segment from `si` to `target` is blocked.
