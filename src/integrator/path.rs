@@ -8,6 +8,7 @@ use crate::first_hit::FirstHitProbe;
 use crate::geometry::{Ray, RayDifferentials, Spectrum};
 use crate::lightbvh::LightContext;
 use crate::lightdistrib::LightStrategy;
+use crate::material::Material;
 use crate::scene::Scene;
 use crate::stream::SampleSource;
 
@@ -51,7 +52,10 @@ pub(super) fn path_li(
     let mut probe = FirstHitProbe::default();
     loop {
         rays += 1;
-        let Some(hit) = scene.intersect(&ray) else {
+        // Scene::intersect's work, with the interaction written straight into `si`: moved
+        // out of an Option of the hit, it was copied three times, each copy a wide reload of
+        // narrow stores that stalls.
+        let Some(hit) = scene.accel.intersect(&ray, f32::INFINITY) else {
             for &i in &scene.infinite_lights {
                 let light = &scene.lights[i as usize];
                 let le = light.le(ray.d.normalize());
@@ -61,14 +65,15 @@ pub(super) fn path_li(
             }
             break;
         };
-        let mut si = hit.si;
+        let surface = scene.surfaces[hit.prim.surface as usize];
+        let mut si = scene.accel.interaction(&ray, &hit);
         // Only the camera ray has differentials (pbrt-v3's path integrator spawns every later
         // ray, and the one through an interface, without them).
         if let Some(d) = diff.take() {
             si.compute_differentials(d);
         }
         probe.travel(ray.o, si.p);
-        if let Some(li) = hit.surface.area_light {
+        if let Some(li) = surface.area_light {
             let light = &scene.lights[li as usize];
             let le = light.l(&si, si.wo);
             if le != Spectrum::ZERO {
@@ -77,7 +82,7 @@ pub(super) fn path_li(
                 });
             }
         }
-        let Some(material) = hit.surface.material else {
+        let Some(material) = surface.material else {
             // An interface between media: continue in the same direction, same depth.
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
@@ -91,7 +96,11 @@ pub(super) fn path_li(
         }
         let material_index = material;
         let material = &scene.materials[material as usize];
-        let si = material.shading(&si);
+        // Only a bump map (or a mix, through its first material) changes the hit: the others'
+        // `shading` is a copy of it, which reloaded its fresh stores in wide pieces and stalled.
+        let shaded = matches!(material, Material::Bumped { .. } | Material::Mix { .. })
+            .then(|| material.shading(&si));
+        let si = shaded.as_ref().unwrap_or(&si);
         let bsdf = material.bsdf(&si);
         probe.surface(&si, &bsdf);
         last.ctx = None;
@@ -100,8 +109,10 @@ pub(super) fn path_li(
                 p: si.p,
                 n: si.shading_n,
             };
+            let direct = next_event(scene, &si, &bsdf, &ctx, light_strategy, stream, &mut rays);
+            // Kept after the light sample: copied at once, the context's fresh narrow stores
+            // were reloaded in wider pieces, which stalls.
             last.ctx = Some(ctx);
-            let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
             if let Some(direct) = direct {
                 l += beta * direct;
             }
