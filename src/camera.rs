@@ -228,7 +228,10 @@ impl Camera {
     /// The ray for a camera sample, its differentials when `differentials` (scaled to one
     /// pixel), and its weight: 1 for every camera but `realistic`, whose rays pbrt-v3
     /// weights (cos^4 and the exit pupil's area) and which returns `None` for a sample the
-    /// lens vignettes (pbrt-v3's zero weight: the sample counts, black).
+    /// lens vignettes (pbrt-v3's zero weight: the sample counts, black). Inlined, with the
+    /// rays it makes, into the caller: returned through memory, the rays were stored in
+    /// pieces and reloaded whole at once, which stalls.
+    #[inline]
     pub fn weighted_ray(
         &self,
         s: &CameraSample,
@@ -314,6 +317,7 @@ impl Camera {
     /// pixel right and one pixel down, with the same lens point and time (pbrt-v3's
     /// perspective and orthographic cameras compute the same rays in closed form; its
     /// environment camera shifts the film point as here).
+    #[inline]
     pub fn generate_ray_differential(&self, s: &CameraSample) -> (Ray, RayDifferentials) {
         if self.lens.is_some() {
             if let Some((ray, Some(diff), _)) = self.weighted_ray(s, true) {
