@@ -231,7 +231,7 @@ impl Camera {
     /// lens vignettes (pbrt-v3's zero weight: the sample counts, black). Inlined, with the
     /// rays it makes, into the caller: returned through memory, the rays were stored in
     /// pieces and reloaded whole at once, which stalls.
-    #[inline]
+    #[inline(always)]
     pub fn weighted_ray(
         &self,
         s: &CameraSample,
@@ -239,12 +239,23 @@ impl Camera {
     ) -> Option<(Ray, Option<RayDifferentials>, f32)> {
         let Some(lens) = &self.lens else {
             return Some(if differentials {
-                let (ray, diff) = self.generate_ray_differential(s);
+                let (ray, diff) = self.projected_ray_differential(s);
                 (ray, Some(diff), 1.0)
             } else {
                 (self.generate_ray(s), None, 1.0)
             });
         };
+        self.realistic_weighted_ray(lens, s, differentials)
+    }
+
+    /// [`Camera::weighted_ray`] for the realistic camera (kept out of line).
+    #[inline(never)]
+    fn realistic_weighted_ray(
+        &self,
+        lens: &LensSystem,
+        s: &CameraSample,
+        differentials: bool,
+    ) -> Option<(Ray, Option<RayDifferentials>, f32)> {
         let (ray, weight) = self.realistic_ray(lens, s)?;
         if !differentials {
             return Some((ray, None, weight));
@@ -317,7 +328,6 @@ impl Camera {
     /// pixel right and one pixel down, with the same lens point and time (pbrt-v3's
     /// perspective and orthographic cameras compute the same rays in closed form; its
     /// environment camera shifts the film point as here).
-    #[inline]
     pub fn generate_ray_differential(&self, s: &CameraSample) -> (Ray, RayDifferentials) {
         if self.lens.is_some() {
             if let Some((ray, Some(diff), _)) = self.weighted_ray(s, true) {
@@ -332,6 +342,12 @@ impl Camera {
             };
             return (ray, diff);
         }
+        self.projected_ray_differential(s)
+    }
+
+    /// [`Camera::generate_ray_differential`] for every camera but the realistic one.
+    #[inline(always)]
+    fn projected_ray_differential(&self, s: &CameraSample) -> (Ray, RayDifferentials) {
         let time = self.time(s);
         let m = self.world_from_camera.at(time);
         let world =
