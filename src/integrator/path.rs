@@ -101,15 +101,15 @@ pub(super) fn path_li(
         let shaded = matches!(material, Material::Bumped { .. } | Material::Mix { .. })
             .then(|| material.shading(&si));
         let si = shaded.as_ref().unwrap_or(&si);
-        let bsdf = material.bsdf(&si);
-        probe.surface(&si, &bsdf);
+        let bsdf = material.bsdf(si);
+        probe.surface(si, &bsdf);
         last.ctx = None;
         if have_lights && bsdf.has_non_specular() {
             let ctx = LightContext {
                 p: si.p,
                 n: si.shading_n,
             };
-            let direct = next_event(scene, &si, &bsdf, &ctx, light_strategy, stream, &mut rays);
+            let direct = next_event(scene, si, &bsdf, &ctx, light_strategy, stream, &mut rays);
             // Kept after the light sample: copied at once, the context's fresh narrow stores
             // were reloaded in wider pieces, which stalls.
             last.ctx = Some(ctx);
@@ -143,7 +143,7 @@ pub(super) fn path_li(
         last.bsdf_pdf = if s.specular { 0.0 } else { s.pdf };
         ray = si.spawn_ray(s.wi);
         // Transmitted into a subsurface material: the path leaves from an exit point instead.
-        if let Some(bssrdf) = transmitted.then(|| material.bssrdf(&si)).flatten() {
+        if let Some(bssrdf) = transmitted.then(|| material.bssrdf(si)).flatten() {
             // The light sampled at the exit point counts as a path one longer than this one.
             let mut at_exit = Spectrum::ZERO;
             let exit = subsurface::scatter(
