@@ -228,7 +228,10 @@ impl Camera {
     /// The ray for a camera sample, its differentials when `differentials` (scaled to one
     /// pixel), and its weight: 1 for every camera but `realistic`, whose rays pbrt-v3
     /// weights (cos^4 and the exit pupil's area) and which returns `None` for a sample the
-    /// lens vignettes (pbrt-v3's zero weight: the sample counts, black).
+    /// lens vignettes (pbrt-v3's zero weight: the sample counts, black). Inlined, with the
+    /// rays it makes, into the caller: returned through memory, the rays were stored in
+    /// pieces and reloaded whole at once, which stalls.
+    #[inline(always)]
     pub fn weighted_ray(
         &self,
         s: &CameraSample,
@@ -236,12 +239,23 @@ impl Camera {
     ) -> Option<(Ray, Option<RayDifferentials>, f32)> {
         let Some(lens) = &self.lens else {
             return Some(if differentials {
-                let (ray, diff) = self.generate_ray_differential(s);
+                let (ray, diff) = self.projected_ray_differential(s);
                 (ray, Some(diff), 1.0)
             } else {
                 (self.generate_ray(s), None, 1.0)
             });
         };
+        self.realistic_weighted_ray(lens, s, differentials)
+    }
+
+    /// [`Camera::weighted_ray`] for the realistic camera (kept out of line).
+    #[inline(never)]
+    fn realistic_weighted_ray(
+        &self,
+        lens: &LensSystem,
+        s: &CameraSample,
+        differentials: bool,
+    ) -> Option<(Ray, Option<RayDifferentials>, f32)> {
         let (ray, weight) = self.realistic_ray(lens, s)?;
         if !differentials {
             return Some((ray, None, weight));
@@ -328,6 +342,12 @@ impl Camera {
             };
             return (ray, diff);
         }
+        self.projected_ray_differential(s)
+    }
+
+    /// [`Camera::generate_ray_differential`] for every camera but the realistic one.
+    #[inline(always)]
+    fn projected_ray_differential(&self, s: &CameraSample) -> (Ray, RayDifferentials) {
         let time = self.time(s);
         let m = self.world_from_camera.at(time);
         let world =

@@ -87,17 +87,18 @@ impl LastScatter {
 
 /// Next-event estimation at `si` for the lights chosen at `ctx`: a light's sampled direct
 /// radiance; `None` when no light can reach the point (its sample's dimensions are spent all
-/// the same, so that later decisions keep their place in the stream).
+/// the same, so that later decisions keep their place in the stream). `ctx` by reference: by
+/// value, its fields were stored and at once reloaded in wider pieces, which stalls.
 pub(super) fn next_event(
     scene: &Scene,
     si: &SurfaceInteraction,
     bsdf: &crate::bsdf::Bsdf,
-    ctx: LightContext,
+    ctx: &LightContext,
     strategy: LightStrategy,
     stream: &mut impl SampleSource,
     rays: &mut u32,
 ) -> Option<Spectrum> {
-    match scene.choose_light(strategy, ctx, stream.next_1d()) {
+    match scene.choose_light(strategy, *ctx, stream.next_1d()) {
         Some((light_index, choice_pdf)) => Some(sample_light(
             scene,
             si,

@@ -107,8 +107,10 @@ pub(super) fn path_li(
                 p: si.p,
                 n: si.shading_n,
             };
+            let direct = next_event(scene, &si, &bsdf, &ctx, light_strategy, stream, &mut rays);
+            // Kept after the light sample: copied at once, the context's fresh narrow stores
+            // were reloaded in wider pieces, which stalls.
             last.ctx = Some(ctx);
-            let direct = next_event(scene, &si, &bsdf, ctx, light_strategy, stream, &mut rays);
             if let Some(direct) = direct {
                 l += beta * direct;
             }

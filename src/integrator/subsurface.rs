@@ -159,7 +159,7 @@ pub(super) fn scatter(
             n: pi.shading_n,
         };
         last.ctx = Some(ctx);
-        if let Some(direct) = next_event(scene, &pi, &bsdf, ctx, strategy, stream, rays) {
+        if let Some(direct) = next_event(scene, &pi, &bsdf, &ctx, strategy, stream, rays) {
             *l += *beta * direct;
         }
     }

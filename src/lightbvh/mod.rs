@@ -31,7 +31,8 @@ struct Node {
     cx: Vec4,
     cy: Vec4,
     cz: Vec4,
-    /// Squared radius of the sphere around each child's bounds.
+    /// Radius of the sphere around each child's bounds, and its square.
+    radius: Vec4,
     radius2: Vec4,
     /// Axis of each child's normals' cone.
     wx: Vec4,
@@ -66,6 +67,7 @@ impl Node {
             cx: Vec4::ZERO,
             cy: Vec4::ZERO,
             cz: Vec4::ZERO,
+            radius: Vec4::ZERO,
             radius2: Vec4::ZERO,
             wx: Vec4::ZERO,
             wy: Vec4::ZERO,
@@ -89,6 +91,7 @@ impl Node {
         self.cy[k] = c.y;
         self.cz[k] = c.z;
         self.radius2[k] = b.lo.distance_squared(c);
+        self.radius[k] = self.radius2[k].sqrt();
         self.wx[k] = b.w.x;
         self.wy[k] = b.w.y;
         self.wz[k] = b.w.z;
@@ -108,26 +111,36 @@ impl Node {
     /// distance, times the cosine of the smallest angle any emitter could make with the
     /// direction to the point (zero outside every emission cone), times the cosine bound at
     /// the receiving surface. Also returns the squared distances to the children's centres.
+    ///
+    /// Every sine and cosine of an angle at the point is a length in the unnormalised
+    /// direction `d` times one reciprocal square root of `|d|^2`: sin w = sqrt(|d|^2 -
+    /// (d.w)^2) / |d|, cos b = sqrt(|d|^2 - r^2) / |d|, sin b = r / |d|, so the square roots
+    /// run side by side rather than after the normalisation (see docs/BENCHMARKS.md, "The
+    /// light BVH's choice and the small rows").
     #[inline(always)]
     fn importance(&self, ctx: LightContext) -> (Vec4, Vec4) {
         let dx = Vec4::splat(ctx.p.x) - self.cx;
         let dy = Vec4::splat(ctx.p.y) - self.cy;
         let dz = Vec4::splat(ctx.p.z) - self.cz;
         let dist2 = dx * dx + dy * dy + dz * dz;
-        // Reciprocals rather than divisions: the distance's, and the floored squared one's
-        // (infinite for a point at a point light, whose importance is then 0).
+        // 1/|d| (0 at the centre, where every direction then counts as inside the bounds),
+        // and the floored squared one's reciprocal (infinite for a point at a point light,
+        // whose importance is then 0).
         let away = dist2.cmpgt(Vec4::ZERO);
-        let inv = Vec4::select(away, dist2.sqrt().recip(), Vec4::ZERO);
+        let inv = Vec4::select(away, rsqrt4(dist2), Vec4::ZERO);
         let inv_d2 = Vec4::select(away, (inv * inv).min(self.inv_d2_floor), self.inv_d2_floor);
-        let (wix, wiy, wiz) = (dx * inv, dy * inv, dz * inv);
-        let cos_w = self.wx * wix + self.wy * wiy + self.wz * wiz;
-        let cos_w = Vec4::select(self.two_sided.cmpgt(Vec4::ZERO), cos_w.abs(), cos_w);
-        let sin_w = safe_sqrt4(Vec4::ONE - cos_w * cos_w);
+        let dw = self.wx * dx + self.wy * dy + self.wz * dz;
+        let dw = Vec4::select(self.two_sided.cmpgt(Vec4::ZERO), dw.abs(), dw);
+        let cos_w = dw * inv;
+        let sin_w = safe_sqrt4(dist2 - dw * dw) * inv;
         // The cone from the point that holds each child's sphere (every direction inside it).
         let inside = dist2.cmplt(self.radius2);
-        let sin2_b = self.radius2 * inv * inv;
-        let cos_b = Vec4::select(inside, Vec4::NEG_ONE, safe_sqrt4(Vec4::ONE - sin2_b));
-        let sin_b = Vec4::select(inside, Vec4::ZERO, safe_sqrt4(sin2_b));
+        let cos_b = Vec4::select(
+            inside,
+            Vec4::NEG_ONE,
+            safe_sqrt4(dist2 - self.radius2) * inv,
+        );
+        let sin_b = Vec4::select(inside, Vec4::ZERO, self.radius * inv);
         let (cos_o, sin_o) = (self.cos_theta_o, self.sin_theta_o);
         let below = cos_w.cmpgt(cos_o);
         let cos_x = Vec4::select(below, Vec4::ONE, cos_w * cos_o + sin_w * sin_o);
@@ -139,8 +152,9 @@ impl Node {
             self.phi * cos_p * inv_d2,
         );
         if ctx.n != Vec3::ZERO {
-            let cos_i = (wix * ctx.n.x + wiy * ctx.n.y + wiz * ctx.n.z).abs();
-            let sin_i = safe_sqrt4(Vec4::ONE - cos_i * cos_i);
+            let dn = (dx * ctx.n.x + dy * ctx.n.y + dz * ctx.n.z).abs();
+            let cos_i = dn * inv;
+            let sin_i = safe_sqrt4(dist2 - dn * dn) * inv;
             importance *= cos_sub_clamped4(sin_i, cos_i, sin_b, cos_b);
         }
         let ok = importance.is_finite_mask() & importance.cmpgt(Vec4::ZERO);
@@ -315,24 +329,22 @@ impl LightBvh {
             if total == 0.0 {
                 return None;
             }
-            // The child whose share of the total holds u (past the last share, by rounding:
-            // the last child that has one). The four shares in one division (each lane's
-            // quotient is the scalar one).
-            let shares = importance / Vec4::splat(total);
+            // The child whose part of the total holds u * total (past the last part, by
+            // rounding: the last child that has one): the choice waits on no division.
+            let target = u * total;
             let (mut k, mut below, mut start) = (4, 0.0, 0.0);
             for j in 0..4 {
                 if importance[j] > 0.0 {
                     (k, start) = (j, below);
-                    below += shares[j];
-                    if u < below {
+                    below += importance[j];
+                    if target < below {
                         break;
                     }
                 }
             }
-            below = start;
-            let p = shares[k];
-            u = clamp_u((u - below) / p);
-            pmf *= p;
+            let w = importance[k];
+            u = clamp_u((target - start) / w);
+            pmf *= w / total;
             let link = node.links[k];
             if link & LEAF != 0 {
                 return Some(((link & INDEX) as usize, pmf));
@@ -402,6 +414,14 @@ fn sum4(v: Vec4) -> f32 {
 #[inline(always)]
 fn clamp_u(u: f32) -> f32 {
     u.clamp(0.0, 1.0 - f32::EPSILON / 2.0)
+}
+
+/// 1/sqrt(x) lane by lane (infinite at 0).
+#[inline(always)]
+fn rsqrt4(x: Vec4) -> Vec4 {
+    // Exact (a square root and a division), not the processor's estimate: the estimate's
+    // bits differ between x86 vendors and from aarch64, and a render's bytes should not.
+    x.sqrt().recip()
 }
 
 #[inline(always)]
