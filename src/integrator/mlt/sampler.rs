@@ -64,6 +64,9 @@ pub struct MltSampler {
     stream_index: u32,
     /// The next coordinate of that stream.
     sample_index: u32,
+    /// Per stream, how many coordinates the proposal under way has drawn (noted at each
+    /// change of stream): `reject` looks at those alone, not at every coordinate.
+    used: [u32; STREAM_COUNT as usize],
 }
 
 impl MltSampler {
@@ -86,6 +89,7 @@ impl MltSampler {
             last_large_step_iteration: 0,
             stream_index: 0,
             sample_index: 0,
+            used: [0; STREAM_COUNT as usize],
         }
     }
 
@@ -105,11 +109,20 @@ impl MltSampler {
     pub fn start_iteration(&mut self) {
         self.current_iteration += 1;
         self.large_step = self.rng.next_f32() < self.large_step_probability;
+        self.used = [0; STREAM_COUNT as usize];
+        self.sample_index = 0;
+    }
+
+    /// Notes how many coordinates the current stream has drawn in this proposal.
+    fn note_stream(&mut self) {
+        let used = &mut self.used[self.stream_index as usize];
+        *used = (*used).max(self.sample_index);
     }
 
     /// Makes the path draw from stream `index` ([`CAMERA_STREAM`], ...), from its start.
     pub fn start_stream(&mut self, index: u32) {
         debug_assert!(index < STREAM_COUNT);
+        self.note_stream();
         self.stream_index = index;
         self.sample_index = 0;
     }
@@ -121,11 +134,17 @@ impl MltSampler {
         }
     }
 
-    /// The proposal was rejected: the coordinates it moved get their values back.
+    /// The proposal was rejected: the coordinates it moved get their values back. Only
+    /// coordinates it drew can have moved (each stream's first `used`); pbrt-v3 looks at every
+    /// coordinate.
     pub fn reject(&mut self) {
-        for xi in &mut self.x {
-            if xi.last_modified == self.current_iteration {
-                xi.restore();
+        self.note_stream();
+        for (k, &used) in self.used.iter().enumerate() {
+            let stream = self.x.iter_mut().skip(k).step_by(STREAM_COUNT as usize);
+            for xi in stream.take(used as usize) {
+                if xi.last_modified == self.current_iteration {
+                    xi.restore();
+                }
             }
         }
         self.current_iteration -= 1;
@@ -145,9 +164,10 @@ impl MltSampler {
 
     /// Brings coordinate `index` up to the iteration under way (pbrt-v3's `EnsureReady`): the
     /// small steps it missed since it was last used are applied as one of their summed width.
+    #[inline]
     fn ensure_ready(&mut self, index: usize) {
         if index >= self.x.len() {
-            self.x.resize(index + 1, PrimarySample::default());
+            self.grow(index + 1);
         }
         let xi = &mut self.x[index];
         // Reset a coordinate not used since the last accepted large step.
@@ -181,7 +201,16 @@ impl MltSampler {
     }
 }
 
+impl MltSampler {
+    /// Makes room for `len` coordinates.
+    #[cold]
+    fn grow(&mut self, len: usize) {
+        self.x.resize(len, PrimarySample::default());
+    }
+}
+
 impl SampleSource for MltSampler {
+    #[inline]
     fn next_1d(&mut self) -> f32 {
         let i = self.next_index();
         self.ensure_ready(i);
@@ -224,6 +253,17 @@ mod tests {
                     assert!(d.min(1.0 - d) < 0.1, "{a} {b}");
                 }
             }
+            s.reject();
+            assert_eq!(values(&s), first_state);
+        }
+        // A proposal that draws fewer coordinates than the state holds (a shorter path)
+        // restores what it drew and leaves the rest.
+        for _ in 0..20 {
+            s.start_iteration();
+            s.start_stream(CAMERA_STREAM);
+            s.next_1d();
+            s.start_stream(CONNECTION_STREAM);
+            s.next_2d();
             s.reject();
             assert_eq!(values(&s), first_state);
         }
