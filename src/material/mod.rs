@@ -119,6 +119,17 @@ impl Material {
         }
     }
 
+    /// [`Material::shading`] in place: `si` is left as it is unless the material bumps it
+    /// (an interaction is about 180 bytes, and each hit of a path copied it).
+    #[inline]
+    pub fn shade(&self, si: &mut SurfaceInteraction) {
+        match self {
+            Material::Bumped { map, .. } => *si = crate::bump::bump(map, si),
+            Material::Mix { materials, .. } => materials[0].shade(si),
+            _ => {}
+        }
+    }
+
     /// The BSSRDF at (shaded) hit `si`, for a subsurface material (bumped or not); `None`
     /// otherwise. A mix gives none: pbrt-v3's mix leaves its first material's BSSRDF, whose
     /// probe rays then look for that material and never find the mix, so its paths end.

@@ -205,71 +205,34 @@ impl Vertex {
         self.media = MediumInterface::default();
     }
 
-    /// Makes this vertex [`Vertex::surface`]'s at the shaded hit `si` with `material`'s BSDF,
-    /// in place: a vertex that held a surface keeps its BSDF's storage and refills it.
+    /// Makes this vertex a surface vertex at the (shaded) interaction it holds (see
+    /// [`super::Subpath::next_interaction`]) with `material`'s BSDF refilled in place, reached
+    /// from `prev` with solid-angle density `pdf`.
     pub fn make_surface(
         &mut self,
-        (si, material): (&SurfaceInteraction, &Material),
+        material: &Material,
         (light, media): (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,
         prev: &Vertex,
         scene: &Scene,
     ) {
+        let point = self
+            .surface
+            .as_mut()
+            .expect("Subpath::next_interaction gives the slot an interaction");
+        material.bsdf_into(&point.si, &mut point.bsdf);
+        let si = &point.si;
+        (self.p, self.ng, self.ns, self.time) = (si.p, si.n, si.shading_n, si.time);
         self.kind = VertexKind::Surface;
         self.beta = beta;
-        self.p = si.p;
-        self.ng = si.n;
-        self.ns = si.shading_n;
-        self.time = si.time;
         self.delta = false;
         self.pdf_fwd = 0.0;
         self.pdf_rev = 0.0;
         self.light = light;
         self.phase = None;
         self.media = media;
-        match &mut self.surface {
-            Some(point) => {
-                point.si = *si;
-                material.bsdf_into(&point.si, &mut point.bsdf);
-            }
-            None => {
-                self.surface = Some(SurfacePoint {
-                    si: *si,
-                    bsdf: material.bsdf(si),
-                })
-            }
-        }
         self.pdf_fwd = prev.convert_density(pdf, self, scene);
-    }
-
-    /// A surface vertex reached from `prev` with solid-angle density `pdf`.
-    pub fn surface(
-        point: SurfacePoint,
-        (light, media): (Option<u32>, MediumInterface),
-        beta: Spectrum,
-        pdf: f32,
-        prev: &Vertex,
-        scene: &Scene,
-    ) -> Self {
-        let si = &point.si;
-        let mut v = Self {
-            kind: VertexKind::Surface,
-            beta,
-            p: si.p,
-            ng: si.n,
-            ns: si.shading_n,
-            time: si.time,
-            delta: false,
-            pdf_fwd: 0.0,
-            pdf_rev: 0.0,
-            light,
-            surface: Some(point),
-            phase: None,
-            media,
-        };
-        v.pdf_fwd = prev.convert_density(pdf, &v, scene);
-        v
     }
 
     /// A scattering point `p` in `medium` (phase function `phase`), reached along `-wo` from
