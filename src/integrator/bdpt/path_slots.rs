@@ -8,7 +8,6 @@ use crate::bsdf::Bsdf;
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec3};
 use crate::material::Material;
 use crate::medium::MediumInterface;
-use crate::scene::Scene;
 use std::ops::{Deref, DerefMut};
 
 /// The vertices of a camera or light subpath; it reads as the slice of its vertices.
@@ -96,12 +95,11 @@ impl Subpath {
         at: (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,
-        scene: &Scene,
     ) {
         let n = self.len;
         debug_assert!(n > 0, "a surface vertex follows the subpath's start");
         let (done, rest) = self.slots.split_at_mut(n);
-        rest[0].make_surface(material, at, beta, pdf, &done[n - 1], scene);
+        rest[0].make_surface(material, at, beta, pdf, &done[n - 1]);
         self.len += 1;
     }
 }

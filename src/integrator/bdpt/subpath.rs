@@ -5,8 +5,11 @@
 use super::path_slots::Subpath;
 use super::vertex::{adjoint_f, correct_shading_normal, Mode, SurfacePoint, Vertex, VertexKind};
 use super::{LightChoice, MAX_PASS_THROUGH};
+use crate::accel::Hit;
 use crate::camera::CameraSample;
-use crate::geometry::{offset_ray_origin, Ray, RayDifferentials, Spectrum, Vec2, Vec3};
+use crate::geometry::{
+    offset_ray_origin, Ray, RayDifferentials, Spectrum, SurfaceInteraction, Vec2, Vec3,
+};
 use crate::light::WorldSphere;
 use crate::scene::Scene;
 use crate::stream::SampleSource;
@@ -125,6 +128,14 @@ pub fn generate_light_subpath<S: SampleSource + ?Sized>(
     n_walk + 1
 }
 
+/// Writes `ray`'s interaction at `hit` into `si`. A function of its own so that `si` is an
+/// argument, which the compiler knows nothing else reads: it then builds the interaction
+/// there instead of on the stack and copying it in.
+#[inline(never)]
+fn write_interaction(scene: &Scene, ray: &Ray, hit: &Hit, si: &mut SurfaceInteraction) {
+    *si = scene.accel.interaction(ray, hit);
+}
+
 /// How a random walk starts.
 struct Walk {
     /// The throughput so far.
@@ -208,7 +219,7 @@ fn random_walk<S: SampleSource + ?Sized>(
         // The hit is written where its vertex will be and shaded there: a copy of its 0.2 kB
         // cost more than the work on it (the reads after a bulk copy stall).
         let si = path.next_interaction();
-        *si = scene.accel.interaction(&ray, &h);
+        write_interaction(scene, &ray, &h, si);
         if let Some(d) = diff.take() {
             si.compute_differentials(d);
         }
@@ -226,7 +237,7 @@ fn random_walk<S: SampleSource + ?Sized>(
         let material = &scene.materials[material as usize];
         material.shade(si);
         let at = (surface.area_light, media);
-        path.push_surface(material, at, beta, pdf_fwd, scene);
+        path.push_surface(material, at, beta, pdf_fwd);
         bounces += 1;
         if bounces >= max_depth {
             break;

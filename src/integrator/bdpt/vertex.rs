@@ -215,7 +215,6 @@ impl Vertex {
         beta: Spectrum,
         pdf: f32,
         prev: &Vertex,
-        scene: &Scene,
     ) {
         let point = self
             .surface
@@ -223,7 +222,8 @@ impl Vertex {
             .expect("Subpath::next_interaction gives the slot an interaction");
         material.bsdf_into(&point.si, &mut point.bsdf);
         let si = &point.si;
-        (self.p, self.ng, self.ns, self.time) = (si.p, si.n, si.shading_n, si.time);
+        let (p, ng) = (si.p, si.n);
+        (self.p, self.ng, self.ns, self.time) = (p, ng, si.shading_n, si.time);
         self.kind = VertexKind::Surface;
         self.beta = beta;
         self.delta = false;
@@ -232,7 +232,8 @@ impl Vertex {
         self.light = light;
         self.phase = None;
         self.media = media;
-        self.pdf_fwd = prev.convert_density(pdf, self, scene);
+        // From the values in hand: reading the vertex's fields just written stalled.
+        self.pdf_fwd = prev.area_density(pdf, p, ng);
     }
 
     /// A scattering point `p` in `medium` (phase function `phase`), reached along `-wo` from
@@ -346,14 +347,21 @@ impl Vertex {
         if next.is_infinite_light(scene) {
             return pdf;
         }
-        let w = next.p - self.p;
+        self.area_density(pdf, next.p, next.ng)
+    }
+
+    /// [`Vertex::convert_density`] towards a point `p` at finite distance, of geometric
+    /// normal `ng` (zero off surfaces).
+    #[inline]
+    fn area_density(&self, pdf: f32, p: Vec3, ng: Vec3) -> f32 {
+        let w = p - self.p;
         let d2 = w.length_squared();
         if d2 == 0.0 {
             return 0.0;
         }
         let inv = 1.0 / d2;
-        let cos = if next.on_surface() {
-            next.ng.dot(w * inv.sqrt()).abs()
+        let cos = if ng != Vec3::ZERO {
+            ng.dot(w * inv.sqrt()).abs()
         } else {
             1.0
         };
