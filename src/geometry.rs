@@ -80,7 +80,7 @@ impl Frame {
 }
 
 /// Where a ray meets a surface, with pbrt's differential geometry.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct SurfaceInteraction {
     /// The hit point.
     pub p: Vec3,

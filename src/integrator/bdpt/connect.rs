@@ -4,9 +4,10 @@
 use super::super::volpath::{cross_interfaces, MediumRay, Toward};
 use super::vertex::{Mode, Vertex, VertexKind};
 use super::LightChoice;
-use crate::geometry::{Spectrum, Vec2};
+use crate::geometry::{Spectrum, Vec2, Vec3};
 use crate::scene::Scene;
 use crate::stream::SampleSource;
+use std::cell::RefCell;
 
 /// One strategy's contribution.
 #[derive(Clone, Copy, Debug, Default)]
@@ -91,6 +92,18 @@ fn geometry_term(a: &Vertex, b: &Vertex) -> f32 {
     g
 }
 
+thread_local! {
+    /// The vertex a strategy samples itself (the light's for s = 1, the camera's for t = 1),
+    /// rewritten field by field for each connection: a vertex is about 1 kB, and building one
+    /// and moving it out cost a copy of all of it per connection.
+    static SAMPLED: RefCell<Vertex> = RefCell::new(Vertex::camera(
+        Vec3::ZERO,
+        Vec3::ZERO,
+        0.0,
+        Spectrum::ZERO,
+    ));
+}
+
 /// pbrt-v3's `ConnectBDPT` for strategy (s, t): `light` and `camera` hold at least s and t
 /// vertices.
 pub fn connect<S: SampleSource + ?Sized>(
@@ -102,12 +115,27 @@ pub fn connect<S: SampleSource + ?Sized>(
     choice: &LightChoice,
     sampler: &mut S,
 ) -> Connection {
-    let mut c = Connection::default();
     // A camera path that escaped connects to nothing.
     if t > 1 && s != 0 && camera[t - 1].kind == VertexKind::Light {
-        return c;
+        return Connection::default();
     }
-    let mut sampled = None;
+    SAMPLED.with(|v| {
+        let v = &mut *v.borrow_mut();
+        connect_with(scene, (light, camera), (s, t), choice, sampler, v)
+    })
+}
+
+/// [`connect`] with the vertex its strategy samples written into `v`.
+fn connect_with<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    (light, camera): (&[Vertex], &[Vertex]),
+    (s, t): (usize, usize),
+    choice: &LightChoice,
+    sampler: &mut S,
+    v: &mut Vertex,
+) -> Connection {
+    let mut c = Connection::default();
+    let mut sampled = false;
     let mut l = Spectrum::ZERO;
     if s == 0 {
         let pt = &camera[t - 1];
@@ -120,17 +148,18 @@ pub fn connect<S: SampleSource + ?Sized>(
         if qs.connectible(scene) {
             if let Some(i) = scene.camera.sample_wi(qs.p, qs.time, u) {
                 if i.pdf > 0.0 && i.we != Spectrum::ZERO {
-                    let v = Vertex::camera(i.p, i.n, qs.time, i.we / i.pdf);
-                    l = qs.beta * qs.f(&v, Mode::Importance) * v.beta;
+                    let at = (i.p, i.n, qs.time);
+                    v.make_endpoint(VertexKind::Camera, at, i.we / i.pdf, None);
+                    l = qs.beta * qs.f(v, Mode::Importance) * v.beta;
                     if qs.on_surface() {
                         l *= i.wi.dot(qs.ns).abs();
                     }
                     if l != Spectrum::ZERO {
                         c.traced = true;
-                        l *= transmittance(scene, qs, &v, sampler);
+                        l *= transmittance(scene, qs, v, sampler);
                     }
                     c.raster = Some(i.raster);
-                    sampled = Some(v);
+                    sampled = true;
                 }
             }
         }
@@ -139,16 +168,16 @@ pub fn connect<S: SampleSource + ?Sized>(
         let u_light = sampler.next_1d();
         let u = sampler.next_2d();
         if pt.connectible(scene) {
-            if let Some((v, weight)) = sample_light_vertex(scene, pt, choice, u_light, u) {
-                l = pt.beta * pt.f(&v, Mode::Radiance) * weight;
+            if let Some(weight) = sample_light_vertex(scene, pt, choice, (u_light, u), v) {
+                l = pt.beta * pt.f(v, Mode::Radiance) * weight;
                 if pt.on_surface() {
                     l *= (v.p - pt.p).normalize_or_zero().dot(pt.ns).abs();
                 }
                 if l != Spectrum::ZERO {
                     c.traced = true;
-                    l *= transmittance(scene, pt, &v, sampler);
+                    l *= transmittance(scene, pt, v, sampler);
                 }
-                sampled = Some(v);
+                sampled = true;
             }
         }
     } else {
@@ -167,22 +196,24 @@ pub fn connect<S: SampleSource + ?Sized>(
     if l == Spectrum::ZERO {
         return c;
     }
-    let w = super::mis::mis_weight(scene, light, camera, sampled.as_ref(), s, t, choice);
+    let sampled = sampled.then_some(&*v);
+    let w = super::mis::mis_weight(scene, light, camera, sampled, s, t, choice);
     c.mis_weight = w;
     c.l = l * w;
     c
 }
 
-/// The s = 1 strategy's light vertex seen from `pt`: a light chosen at `pt` as `path` chooses
-/// one (the strategy's choice), a point on it by `Light::sample_li`, and the weight
-/// Le / (pdf of the point and of the choice); `None` when it sends nothing.
+/// The s = 1 strategy's light vertex seen from `pt`, written into `v`: a light chosen at `pt`
+/// as `path` chooses one (the strategy's choice) with `u_light`, a point on it by
+/// `Light::sample_li` with `u`; returns the weight Le / (pdf of the point and of the choice),
+/// `None` (and `v` not a light vertex) when it sends nothing.
 fn sample_light_vertex(
     scene: &Scene,
     pt: &Vertex,
     choice: &LightChoice,
-    u_light: f32,
-    u: Vec2,
-) -> Option<(Vertex, Spectrum)> {
+    (u_light, u): (f32, Vec2),
+    v: &mut Vertex,
+) -> Option<Spectrum> {
     let (index, choice_pdf) = choice.sample_at(scene, pt, u_light)?;
     let light = &scene.lights[index];
     let (ls, n) = light.sample_li_with_normal(&scene.accel.world, pt.p, u)?;
@@ -190,14 +221,8 @@ fn sample_light_vertex(
         return None;
     }
     let weight = ls.li / (ls.pdf * choice_pdf);
-    let mut v = Vertex::endpoint(
-        VertexKind::Light,
-        ls.p,
-        n,
-        pt.time,
-        weight,
-        Some(index as u32),
-    );
+    let at = (ls.p, n, pt.time);
+    v.make_endpoint(VertexKind::Light, at, weight, Some(index as u32));
     v.pdf_fwd = v.pdf_light_origin(scene, pt, choice);
-    Some((v, weight))
+    Some(weight)
 }

@@ -1,13 +1,13 @@
 //! A subpath's vertices kept from path to path: the slots past the path's length keep their
-//! storage, so that a surface vertex's BSDF (about 0.7 kB, held by value) is refilled in place
-//! where it was built, moved into its vertex and moved into the list for every vertex of every
-//! path (docs/light-transport.md, `## bdpt`).
+//! storage, so that a surface vertex's interaction (about 0.2 kB) and BSDF (about 0.7 kB, held
+//! by value) are written in place where they were built, moved into its vertex and moved into
+//! the list for every vertex of every path (docs/light-transport.md, `## bdpt`).
 
 use super::vertex::{SurfacePoint, Vertex, VertexKind};
+use crate::bsdf::Bsdf;
 use crate::geometry::{Spectrum, SurfaceInteraction, Vec3};
 use crate::material::Material;
 use crate::medium::MediumInterface;
-use crate::scene::Scene;
 use std::ops::{Deref, DerefMut};
 
 /// The vertices of a camera or light subpath; it reads as the slice of its vertices.
@@ -62,30 +62,44 @@ impl Subpath {
         &mut self.slots[self.len - 1]
     }
 
-    /// Appends [`Vertex::surface`]'s vertex at the shaded hit `si` with `material`'s BSDF,
-    /// reached from the last vertex with solid-angle density `pdf`; a kept slot that held a
-    /// surface has its BSDF refilled in place.
+    /// The interaction of the vertex that comes next, for the walk to write the hit into and
+    /// shade in place; [`Subpath::push_surface`] makes it a vertex (else it is not one).
+    pub fn next_interaction(&mut self) -> &mut SurfaceInteraction {
+        if self.len == self.slots.len() {
+            let at = (Vec3::ZERO, Vec3::ZERO, 0.0);
+            self.slots.push(Vertex::endpoint(
+                VertexKind::Surface,
+                at.0,
+                at.1,
+                at.2,
+                Spectrum::ZERO,
+                None,
+            ));
+        }
+        let point = self.slots[self.len].surface.get_or_insert_with(|| {
+            let si = SurfaceInteraction::default();
+            SurfacePoint {
+                bsdf: Bsdf::new(&si, 1.0),
+                si,
+            }
+        });
+        &mut point.si
+    }
+
+    /// Appends the surface vertex at the (shaded) hit [`Subpath::next_interaction`] holds,
+    /// with `material`'s BSDF refilled in place, reached from the last vertex with solid-angle
+    /// density `pdf`.
     pub fn push_surface(
         &mut self,
-        (si, material): (&SurfaceInteraction, &Material),
+        material: &Material,
         at: (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,
-        scene: &Scene,
     ) {
         let n = self.len;
         debug_assert!(n > 0, "a surface vertex follows the subpath's start");
-        if n == self.slots.len() {
-            let point = SurfacePoint {
-                si: *si,
-                bsdf: material.bsdf(si),
-            };
-            let v = Vertex::surface(point, at, beta, pdf, &self.slots[n - 1], scene);
-            self.slots.push(v);
-        } else {
-            let (done, rest) = self.slots.split_at_mut(n);
-            rest[0].make_surface((si, material), at, beta, pdf, &done[n - 1], scene);
-        }
+        let (done, rest) = self.slots.split_at_mut(n);
+        rest[0].make_surface(material, at, beta, pdf, &done[n - 1]);
         self.len += 1;
     }
 }

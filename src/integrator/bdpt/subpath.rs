@@ -5,8 +5,11 @@
 use super::path_slots::Subpath;
 use super::vertex::{adjoint_f, correct_shading_normal, Mode, SurfacePoint, Vertex, VertexKind};
 use super::{LightChoice, MAX_PASS_THROUGH};
+use crate::accel::Hit;
 use crate::camera::CameraSample;
-use crate::geometry::{offset_ray_origin, Ray, RayDifferentials, Spectrum, Vec2, Vec3};
+use crate::geometry::{
+    offset_ray_origin, Ray, RayDifferentials, Spectrum, SurfaceInteraction, Vec2, Vec3,
+};
 use crate::light::WorldSphere;
 use crate::scene::Scene;
 use crate::stream::SampleSource;
@@ -48,6 +51,10 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
     }
     let at = (ray.o, Vec3::ZERO, ray.time);
     path.push_endpoint(VertexKind::Camera, at, Spectrum::ONE, None);
+    if max_depth == 1 {
+        // The camera alone (mlt's t = 1): the ray's density would go unused.
+        return 1;
+    }
     let pdf_dir = scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
     let walk = Walk {
         beta: Spectrum::ONE,
@@ -121,6 +128,14 @@ pub fn generate_light_subpath<S: SampleSource + ?Sized>(
     n_walk + 1
 }
 
+/// Writes `ray`'s interaction at `hit` into `si`. A function of its own so that `si` is an
+/// argument, which the compiler knows nothing else reads: it then builds the interaction
+/// there instead of on the stack and copying it in.
+#[inline(never)]
+fn write_interaction(scene: &Scene, ray: &Ray, hit: &Hit, si: &mut SurfaceInteraction) {
+    *si = scene.accel.interaction(ray, hit);
+}
+
 /// How a random walk starts.
 struct Walk {
     /// The throughput so far.
@@ -189,11 +204,7 @@ fn random_walk<S: SampleSource + ?Sized>(
                 continue;
             }
         }
-        let hit = raw.map(|h| crate::scene::SceneHit {
-            si: scene.accel.interaction(&ray, &h),
-            surface: scene.surfaces[h.prim.surface as usize],
-        });
-        let Some(hit) = hit else {
+        let Some(h) = raw else {
             // Camera rays that escape end on the infinite lights.
             if mode == Mode::Radiance {
                 let d = ray.d.normalize();
@@ -204,25 +215,29 @@ fn random_walk<S: SampleSource + ?Sized>(
             }
             break;
         };
-        let mut si = hit.si;
+        let surface = &scene.surfaces[h.prim.surface as usize];
+        // The hit is written where its vertex will be and shaded there: a copy of its 0.2 kB
+        // cost more than the work on it (the reads after a bulk copy stall).
+        let si = path.next_interaction();
+        write_interaction(scene, &ray, &h, si);
         if let Some(d) = diff.take() {
             si.compute_differentials(d);
         }
-        let Some(material) = hit.surface.material else {
+        let Some(material) = surface.material else {
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
                 break;
             }
-            let media = super::super::volpath::media_at(&hit.surface, medium);
+            let media = super::super::volpath::media_at(surface, medium);
             medium = media.toward(si.n, ray.d);
             ray = si.spawn_ray(ray.d);
             continue;
         };
-        let media = super::super::volpath::media_at(&hit.surface, medium);
+        let media = super::super::volpath::media_at(surface, medium);
         let material = &scene.materials[material as usize];
-        let si = material.shading(&si);
-        let at = (hit.surface.area_light, media);
-        path.push_surface((&si, material), at, beta, pdf_fwd, scene);
+        material.shade(si);
+        let at = (surface.area_light, media);
+        path.push_surface(material, at, beta, pdf_fwd);
         bounces += 1;
         if bounces >= max_depth {
             break;

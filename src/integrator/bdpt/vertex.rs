@@ -205,71 +205,35 @@ impl Vertex {
         self.media = MediumInterface::default();
     }
 
-    /// Makes this vertex [`Vertex::surface`]'s at the shaded hit `si` with `material`'s BSDF,
-    /// in place: a vertex that held a surface keeps its BSDF's storage and refills it.
+    /// Makes this vertex a surface vertex at the (shaded) interaction it holds (see
+    /// [`super::Subpath::next_interaction`]) with `material`'s BSDF refilled in place, reached
+    /// from `prev` with solid-angle density `pdf`.
     pub fn make_surface(
         &mut self,
-        (si, material): (&SurfaceInteraction, &Material),
+        material: &Material,
         (light, media): (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,
         prev: &Vertex,
-        scene: &Scene,
     ) {
+        let point = self
+            .surface
+            .as_mut()
+            .expect("Subpath::next_interaction gives the slot an interaction");
+        material.bsdf_into(&point.si, &mut point.bsdf);
+        let si = &point.si;
+        let (p, ng) = (si.p, si.n);
+        (self.p, self.ng, self.ns, self.time) = (p, ng, si.shading_n, si.time);
         self.kind = VertexKind::Surface;
         self.beta = beta;
-        self.p = si.p;
-        self.ng = si.n;
-        self.ns = si.shading_n;
-        self.time = si.time;
         self.delta = false;
         self.pdf_fwd = 0.0;
         self.pdf_rev = 0.0;
         self.light = light;
         self.phase = None;
         self.media = media;
-        match &mut self.surface {
-            Some(point) => {
-                point.si = *si;
-                material.bsdf_into(&point.si, &mut point.bsdf);
-            }
-            None => {
-                self.surface = Some(SurfacePoint {
-                    si: *si,
-                    bsdf: material.bsdf(si),
-                })
-            }
-        }
-        self.pdf_fwd = prev.convert_density(pdf, self, scene);
-    }
-
-    /// A surface vertex reached from `prev` with solid-angle density `pdf`.
-    pub fn surface(
-        point: SurfacePoint,
-        (light, media): (Option<u32>, MediumInterface),
-        beta: Spectrum,
-        pdf: f32,
-        prev: &Vertex,
-        scene: &Scene,
-    ) -> Self {
-        let si = &point.si;
-        let mut v = Self {
-            kind: VertexKind::Surface,
-            beta,
-            p: si.p,
-            ng: si.n,
-            ns: si.shading_n,
-            time: si.time,
-            delta: false,
-            pdf_fwd: 0.0,
-            pdf_rev: 0.0,
-            light,
-            surface: Some(point),
-            phase: None,
-            media,
-        };
-        v.pdf_fwd = prev.convert_density(pdf, &v, scene);
-        v
+        // From the values in hand: reading the vertex's fields just written stalled.
+        self.pdf_fwd = prev.area_density(pdf, p, ng);
     }
 
     /// A scattering point `p` in `medium` (phase function `phase`), reached along `-wo` from
@@ -383,14 +347,21 @@ impl Vertex {
         if next.is_infinite_light(scene) {
             return pdf;
         }
-        let w = next.p - self.p;
+        self.area_density(pdf, next.p, next.ng)
+    }
+
+    /// [`Vertex::convert_density`] towards a point `p` at finite distance, of geometric
+    /// normal `ng` (zero off surfaces).
+    #[inline]
+    fn area_density(&self, pdf: f32, p: Vec3, ng: Vec3) -> f32 {
+        let w = p - self.p;
         let d2 = w.length_squared();
         if d2 == 0.0 {
             return 0.0;
         }
         let inv = 1.0 / d2;
-        let cos = if next.on_surface() {
-            next.ng.dot(w * inv.sqrt()).abs()
+        let cos = if ng != Vec3::ZERO {
+            ng.dot(w * inv.sqrt()).abs()
         } else {
             1.0
         };

@@ -25,8 +25,8 @@ thread_local! {
 pub struct BdptContribution {
     /// The longest path, in bounces.
     pub max_depth: u32,
-    /// How lights are chosen, as bdpt chooses them ([`LightChoice`]): the light subpath's
-    /// light by power (as pbrt-v3's light distribution), the s = 1 strategy's by this.
+    /// How lights are chosen ([`LightChoice`]): mlt passes `Power`, pbrt-v3's mlt's light
+    /// distribution, for the light subpath's light and the s = 1 strategy's alike.
     pub light_strategy: LightStrategy,
     /// The camera ray's differentials' scale: 1/sqrt(mutations per pixel), as pbrt-v3's
     /// `GenerateCameraSubpath` scales them by its sampler's samples per pixel (the MLT

@@ -219,7 +219,8 @@ pub fn render(
 ) -> RenderCounts {
     let f = BdptContribution {
         max_depth: settings.max_depth,
-        light_strategy: LightStrategy::Bvh,
+        // pbrt-v3's mlt chooses every light by power (its `lightDistr`), s = 1 included.
+        light_strategy: LightStrategy::Power,
         differential_scale: 1.0 / (settings.mutations_per_pixel.max(1) as f32).sqrt(),
     };
     render_with(&f, scene, settings, film, seed, stop, progress)

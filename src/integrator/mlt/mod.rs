@@ -12,6 +12,7 @@
 pub mod bdpt_path;
 pub mod chain;
 pub mod contribution;
+pub mod gaussian;
 pub mod sampler;
 
 use super::IntegratorBuild;

@@ -3,6 +3,7 @@
 //! asks for them; a large step draws them afresh, a small step moves each by a Gaussian of
 //! width `sigma` (wrapped into [0, 1)), and a rejected proposal restores the ones it moved.
 
+use super::gaussian::Ziggurat;
 use crate::stream::{mix64, Pcg32, SampleSource};
 
 /// The sample streams pbrt-v3's mlt interleaves: the camera subpath's, the light subpath's
@@ -47,6 +48,8 @@ pub struct MltSampler {
     x: Vec<PrimarySample>,
     /// Draws the mutations.
     rng: Pcg32,
+    /// Turns the generator's draws into the small steps' Gaussian deviates.
+    normal: &'static Ziggurat,
     /// The width of a small step.
     sigma: f32,
     /// The chance that a proposal is a large step.
@@ -61,6 +64,9 @@ pub struct MltSampler {
     stream_index: u32,
     /// The next coordinate of that stream.
     sample_index: u32,
+    /// Per stream, how many coordinates the proposal under way has drawn (noted at each
+    /// change of stream): `reject` looks at those alone, not at every coordinate.
+    used: [u32; STREAM_COUNT as usize],
 }
 
 impl MltSampler {
@@ -75,6 +81,7 @@ impl MltSampler {
                 let key = mix64(seed ^ 0x6d6c_745f_7361_6d70);
                 Pcg32::new(mix64(key ^ mix64(index)), mix64(key).wrapping_add(index))
             },
+            normal: Ziggurat::get(),
             sigma,
             large_step_probability,
             current_iteration: 0,
@@ -82,6 +89,7 @@ impl MltSampler {
             last_large_step_iteration: 0,
             stream_index: 0,
             sample_index: 0,
+            used: [0; STREAM_COUNT as usize],
         }
     }
 
@@ -101,11 +109,20 @@ impl MltSampler {
     pub fn start_iteration(&mut self) {
         self.current_iteration += 1;
         self.large_step = self.rng.next_f32() < self.large_step_probability;
+        self.used = [0; STREAM_COUNT as usize];
+        self.sample_index = 0;
+    }
+
+    /// Notes how many coordinates the current stream has drawn in this proposal.
+    fn note_stream(&mut self) {
+        let used = &mut self.used[self.stream_index as usize];
+        *used = (*used).max(self.sample_index);
     }
 
     /// Makes the path draw from stream `index` ([`CAMERA_STREAM`], ...), from its start.
     pub fn start_stream(&mut self, index: u32) {
         debug_assert!(index < STREAM_COUNT);
+        self.note_stream();
         self.stream_index = index;
         self.sample_index = 0;
     }
@@ -117,11 +134,17 @@ impl MltSampler {
         }
     }
 
-    /// The proposal was rejected: the coordinates it moved get their values back.
+    /// The proposal was rejected: the coordinates it moved get their values back. Only
+    /// coordinates it drew can have moved (each stream's first `used`); pbrt-v3 looks at every
+    /// coordinate.
     pub fn reject(&mut self) {
-        for xi in &mut self.x {
-            if xi.last_modified == self.current_iteration {
-                xi.restore();
+        self.note_stream();
+        for (k, &used) in self.used.iter().enumerate() {
+            let stream = self.x.iter_mut().skip(k).step_by(STREAM_COUNT as usize);
+            for xi in stream.take(used as usize) {
+                if xi.last_modified == self.current_iteration {
+                    xi.restore();
+                }
             }
         }
         self.current_iteration -= 1;
@@ -141,9 +164,10 @@ impl MltSampler {
 
     /// Brings coordinate `index` up to the iteration under way (pbrt-v3's `EnsureReady`): the
     /// small steps it missed since it was last used are applied as one of their summed width.
+    #[inline]
     fn ensure_ready(&mut self, index: usize) {
         if index >= self.x.len() {
-            self.x.resize(index + 1, PrimarySample::default());
+            self.grow(index + 1);
         }
         let xi = &mut self.x[index];
         // Reset a coordinate not used since the last accepted large step.
@@ -156,7 +180,9 @@ impl MltSampler {
             xi.value = self.rng.next_f32();
         } else {
             let n_small = self.current_iteration - xi.last_modified;
-            let normal = std::f32::consts::SQRT_2 * erf_inv(2.0 * self.rng.next_f32() - 1.0);
+            // pbrt-v3 draws sqrt(2) erfinv(2u - 1), one logarithm and a long polynomial a
+            // deviate; the ziggurat's deviates are exactly normal and mostly a table look-up.
+            let normal = self.normal.sample(&mut self.rng);
             // A coordinate moved at every iteration (most of them) needs no square root:
             // sqrt(1) is 1 exactly, so the value is the same.
             let eff_sigma = if n_small == 1 {
@@ -175,7 +201,16 @@ impl MltSampler {
     }
 }
 
+impl MltSampler {
+    /// Makes room for `len` coordinates.
+    #[cold]
+    fn grow(&mut self, len: usize) {
+        self.x.resize(len, PrimarySample::default());
+    }
+}
+
 impl SampleSource for MltSampler {
+    #[inline]
     fn next_1d(&mut self) -> f32 {
         let i = self.next_index();
         self.ensure_ready(i);
@@ -183,62 +218,9 @@ impl SampleSource for MltSampler {
     }
 }
 
-/// The inverse error function (pbrt-v3's `ErfInv`, Giles' single-precision approximation).
-// pbrt-v3's coefficients as it writes them.
-#[allow(clippy::excessive_precision)]
-pub fn erf_inv(x: f32) -> f32 {
-    let x = x.clamp(-0.99999, 0.99999);
-    let mut w = -((1.0 - x) * (1.0 + x)).ln();
-    let p = if w < 5.0 {
-        w -= 2.5;
-        [
-            3.432_739_4e-7,
-            -3.523_387_7e-6,
-            -4.391_506_5e-6,
-            0.000_218_580_87,
-            -0.001_253_725,
-            -0.004_177_681_6,
-            0.246_640_73,
-            1.501_409_4,
-        ]
-        .iter()
-        .fold(2.810_226_4e-8_f32, |p, &c| c + p * w)
-    } else {
-        w = w.sqrt() - 3.0;
-        [
-            0.000_100_950_56,
-            0.001_349_343_2,
-            -0.003_673_428_4,
-            0.005_739_507_7,
-            -0.007_622_461,
-            0.009_438_870_5,
-            1.001_674_1,
-            2.832_976_8,
-        ]
-        .iter()
-        .fold(-0.000_200_214_26_f32, |p, &c| c + p * w)
-    };
-    p * x
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    #[allow(clippy::excessive_precision)]
-    fn erf_inv_inverts_erf() {
-        // erf(0.5) = 0.520499877813, erf(1) = 0.842700792950, erf(2) = 0.995322265019.
-        for (x, y) in [
-            (0.5f32, 0.520_499_88f32),
-            (1.0, 0.842_700_8),
-            (2.0, 0.995_322_3),
-        ] {
-            assert!((erf_inv(y) - x).abs() < 1e-3 * x, "{x} {}", erf_inv(y));
-            assert!((erf_inv(-y) + x).abs() < 1e-3 * x);
-        }
-        assert_eq!(erf_inv(0.0), 0.0);
-    }
 
     #[test]
     fn a_rejected_proposal_restores_the_state_and_an_accepted_one_keeps_it() {
@@ -271,6 +253,17 @@ mod tests {
                     assert!(d.min(1.0 - d) < 0.1, "{a} {b}");
                 }
             }
+            s.reject();
+            assert_eq!(values(&s), first_state);
+        }
+        // A proposal that draws fewer coordinates than the state holds (a shorter path)
+        // restores what it drew and leaves the rest.
+        for _ in 0..20 {
+            s.start_iteration();
+            s.start_stream(CAMERA_STREAM);
+            s.next_1d();
+            s.start_stream(CONNECTION_STREAM);
+            s.next_2d();
             s.reject();
             assert_eq!(values(&s), first_state);
         }
