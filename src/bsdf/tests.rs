@@ -456,20 +456,8 @@ fn lobes_said_to_sample_their_value_do_so_bit_for_bit() {
 #[test]
 fn a_refilled_bsdf_is_a_fresh_one() {
     let si = SurfaceInteraction {
-        p: Vec3::ZERO,
-        n: Vec3::Z,
-        uv: Vec2::ZERO,
-        dpdu: Vec3::X,
-        dpdv: Vec3::Y,
         shading_n: Vec3::new(0.1, 0.0, 1.0).normalize(),
-        shading_dpdu: Vec3::X,
-        shading_dpdv: Vec3::Y,
-        dndu: Vec3::ZERO,
-        dndv: Vec3::ZERO,
-        wo: Vec3::Z,
-        time: 0.0,
-        p_error: 0.0,
-        diff: Default::default(),
+        ..SurfaceInteraction::flat(Vec3::ZERO, Vec2::ZERO)
     };
     let lobes = non_specular_lobes();
     // Three lobes, then refilled with two: the third slot still holds a lobe, never read.
