@@ -22,13 +22,17 @@ pub struct Grid {
     entries: Vec<u32>,
 }
 
+/// Pixels whose (bucket, pixel) pairs one task makes.
+const PIXELS_PER_CHUNK: usize = 256;
+
 /// pbrt-v3's hash of a cell into `size` buckets.
 #[inline]
 fn hash(c: [i32; 3], size: usize) -> usize {
     let h = c[0].wrapping_mul(73_856_093)
         ^ c[1].wrapping_mul(19_349_663)
         ^ c[2].wrapping_mul(83_492_791);
-    (h as u32 as usize) % size
+    // A 32-bit remainder (the pixel count fits: pixels are u32), cheaper than a 64-bit one.
+    (h as u32 % size as u32) as usize
 }
 
 impl Grid {
@@ -61,22 +65,27 @@ impl Grid {
             entries: Vec::new(),
         };
         let buckets = visible.len().max(1);
+        // One list per chunk of pixels, not per pixel (a small allocation per pixel and
+        // iteration cost more than the pairs themselves).
         let pairs: Vec<(u32, u32)> = visible
-            .par_iter()
-            .zip(radii.par_iter())
+            .par_chunks(PIXELS_PER_CHUNK)
+            .zip(radii.par_chunks(PIXELS_PER_CHUNK))
             .enumerate()
-            .flat_map_iter(|(i, (vp, &r))| {
+            .flat_map_iter(|(chunk, (vps, rs))| {
                 let mut own: Vec<(u32, u32)> = Vec::new();
-                if let Some(vp) = vp {
+                for (k, (vp, &r)) in vps.iter().zip(rs).enumerate() {
+                    let Some(vp) = vp else { continue };
+                    let i = (chunk * PIXELS_PER_CHUNK + k) as u32;
+                    let first = own.len();
                     let (a, _) = grid.cell(vp.p - Vec3::splat(r));
                     let (b, _) = grid.cell(vp.p + Vec3::splat(r));
                     for z in a[2]..=b[2] {
                         for y in a[1]..=b[1] {
                             for x in a[0]..=b[0] {
-                                let e = (hash([x, y, z], buckets) as u32, i as u32);
+                                let e = (hash([x, y, z], buckets) as u32, i);
                                 // Two of its cells in one bucket would count each photon there
                                 // twice (a point spans few cells: a scan is cheapest).
-                                if !own.contains(&e) {
+                                if !own[first..].contains(&e) {
                                     own.push(e);
                                 }
                             }

@@ -256,7 +256,7 @@ pub fn render(
     if let Some(p) = progress {
         p.set_length(u64::from(settings.iterations));
     }
-    let shooter = photons::Shooter::new(scene, settings.max_depth, seed);
+    let mut shooter = photons::Shooter::new(scene, settings.max_depth, seed);
     let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     let mut visible = Vec::new();
     let mut done = 0u32;

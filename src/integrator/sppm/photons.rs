@@ -34,6 +34,7 @@ const PRIMES: [u32; 48] = [
 ];
 
 /// What one iteration's photons brought to the visible points.
+#[derive(Default)]
 pub struct Gathered {
     /// Flux at each pixel's visible point (pbrt-v3's `Phi`).
     pub phi: Vec<[f64; 3]>,
@@ -54,6 +55,12 @@ pub struct Shooter<'s> {
     /// Each dimension's shift (Cranley-Patterson rotation) under the seed.
     shifts: [f32; PRIMES.len()],
     seed: u64,
+    /// The last iteration's gatherings (its buffers reused).
+    gathered: Gathered,
+    /// Each pixel's visible point and squared radius, for the lookups.
+    near: Vec<(Vec3, f32)>,
+    /// One round's blocks (their deposit lists reused).
+    pool: Vec<Block>,
 }
 
 /// SplitMix64's finaliser.
@@ -74,6 +81,18 @@ fn unit(h: u64) -> f32 {
 fn radical_inverse<const B: u64>(mut i: u64) -> f32 {
     let inv = 1.0 / B as f64;
     let (mut reversed, mut factor) = (0u64, 1.0f64);
+    // Below 2^32 (every index short of four billion photons) the digits come from 32-bit
+    // divisions, cheaper than 64-bit ones; the digits and so the value are the same.
+    if let Ok(mut j) = u32::try_from(i) {
+        let b = B as u32;
+        while j > 0 {
+            let next = j / b;
+            reversed = reversed * B + u64::from(j - next * b);
+            factor *= inv;
+            j = next;
+        }
+        i = 0;
+    }
     while i > 0 {
         let next = i / B;
         reversed = reversed * B + (i - next * B);
@@ -160,59 +179,64 @@ impl<'s> Shooter<'s> {
             max_depth,
             shifts,
             seed,
+            gathered: Gathered::default(),
+            near: Vec::new(),
+            pool: Vec::new(),
         }
     }
 
     /// Shoots iteration `iter`'s `count` photons at the visible points in `grid` (`visible`
     /// and `radii` by pixel).
     pub fn shoot(
-        &self,
+        &mut self,
         grid: &Grid,
         visible: &[Option<VisiblePoint>],
         radii: &[f32],
         iter: u32,
         count: u64,
-    ) -> Gathered {
-        let mut g = Gathered {
-            phi: vec![[0.0; 3]; visible.len()],
-            m: vec![0; visible.len()],
-            rays: 0,
-            dropped: 0,
-        };
+    ) -> &Gathered {
+        // The buffers are kept from iteration to iteration: allocating, growing and freeing
+        // them each time cost about 3% of a render (perf).
+        let g = &mut self.gathered;
+        g.phi.clear();
+        g.phi.resize(visible.len(), [0.0; 3]);
+        g.m.clear();
+        g.m.resize(visible.len(), 0);
+        (g.rays, g.dropped) = (0, 0);
         if self.scene.lights.is_empty() {
-            return g;
+            return &self.gathered;
         }
         // Each pixel's visible point and squared radius packed in 16 bytes: the lookups test
         // distances here instead of in the visible points (about 0.8 kB each, with their
         // BSDFs), which cache misses made slow. No visible point: a radius that takes nothing.
-        let near: Vec<(Vec3, f32)> = visible
-            .iter()
-            .zip(radii)
-            .map(|(vp, &r)| match vp {
-                Some(vp) => (vp.p, r * r),
-                None => (Vec3::ZERO, f32::NEG_INFINITY),
-            })
-            .collect();
+        let mut near = std::mem::take(&mut self.near);
+        near.clear();
+        near.extend(visible.iter().zip(radii).map(|(vp, &r)| match vp {
+            Some(vp) => (vp.p, r * r),
+            None => (Vec3::ZERO, f32::NEG_INFINITY),
+        }));
+        let mut pool = std::mem::take(&mut self.pool);
+        pool.resize_with(BLOCKS_PER_ROUND as usize, Block::default);
+        let mut g = std::mem::take(&mut self.gathered);
         let first = u64::from(iter) * count;
         let blocks = count.div_ceil(BLOCK);
         let mut round = 0;
         while round < blocks {
             let end = (round + BLOCKS_PER_ROUND).min(blocks);
-            let traced: Vec<Block> = (round..end)
-                .into_par_iter()
-                .map(|b| {
-                    let mut block = Block::default();
-                    let mut bsdf = Bsdf::empty();
-                    for i in b * BLOCK..((b + 1) * BLOCK).min(count) {
-                        self.trace(first + i, grid, visible, &near, &mut bsdf, &mut block);
-                    }
-                    block
-                })
-                .collect();
-            for block in traced {
+            let traced = &mut pool[..(end - round) as usize];
+            traced.par_iter_mut().enumerate().for_each(|(k, block)| {
+                block.deposits.clear();
+                (block.rays, block.dropped) = (0, 0);
+                let b = round + k as u64;
+                let mut bsdf = Bsdf::empty();
+                for i in b * BLOCK..((b + 1) * BLOCK).min(count) {
+                    self.trace(first + i, grid, visible, &near, &mut bsdf, block);
+                }
+            });
+            for block in traced.iter() {
                 g.rays += block.rays;
                 g.dropped += block.dropped;
-                for (pixel, phi) in block.deposits {
+                for &(pixel, phi) in &block.deposits {
                     let (s, m) = (&mut g.phi[pixel as usize], &mut g.m[pixel as usize]);
                     s[0] += f64::from(phi.x);
                     s[1] += f64::from(phi.y);
@@ -222,7 +246,8 @@ impl<'s> Shooter<'s> {
             }
             round = end;
         }
-        g
+        (self.near, self.pool, self.gathered) = (near, pool, g);
+        &self.gathered
     }
 
     /// Traces photon `index` (over all iterations), its deposits added to `block`; `near` is
