@@ -285,10 +285,12 @@ impl<'s> Shooter<'s> {
         let mut pass_through = 0;
         while depth < self.max_depth {
             block.rays += 1;
-            let Some(hit) = scene.intersect(&ray) else {
+            let Some(hit) = scene.closest_hit(&ray) else {
                 break;
             };
-            let mut si = hit.si;
+            // Made in its local: a hit returned with its interaction was copied (180 bytes).
+            let mut si = scene.interaction(&ray, &hit);
+            let surface = scene.surface_of(&hit);
             if depth > 0 {
                 let wi = -ray.d.normalize();
                 for &pixel in grid.candidates(si.p) {
@@ -307,7 +309,7 @@ impl<'s> Shooter<'s> {
                     }
                 }
             }
-            let Some(material) = hit.surface.material else {
+            let Some(material) = surface.material else {
                 pass_through += 1;
                 if pass_through > MAX_PASS_THROUGH {
                     break;

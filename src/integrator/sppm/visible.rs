@@ -123,17 +123,19 @@ impl CameraPass<'_> {
         });
         while depth < self.max_depth {
             rays += 1;
-            let Some(hit) = scene.intersect(&ray) else {
+            let Some(hit) = scene.closest_hit(&ray) else {
                 for &l in &scene.infinite_lights {
                     ld += beta * scene.lights[l as usize].le(ray.d.normalize());
                 }
                 break;
             };
-            let mut si = hit.si;
+            // Made in its local: a hit returned with its interaction was copied (180 bytes).
+            let mut si = scene.interaction(&ray, &hit);
+            let surface = scene.surface_of(&hit);
             if let Some(d) = diff.take() {
                 si.compute_differentials(&d);
             }
-            let Some(material) = hit.surface.material else {
+            let Some(material) = surface.material else {
                 pass_through += 1;
                 if pass_through > MAX_PASS_THROUGH {
                     break;
@@ -142,7 +144,7 @@ impl CameraPass<'_> {
                 continue;
             };
             if depth == 0 || specular_bounce {
-                if let Some(l) = hit.surface.area_light {
+                if let Some(l) = surface.area_light {
                     ld += beta * scene.lights[l as usize].l(&si, si.wo);
                 }
             }
