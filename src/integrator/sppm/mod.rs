@@ -256,9 +256,10 @@ pub fn render(
     if let Some(p) = progress {
         p.set_length(u64::from(settings.iterations));
     }
-    let shooter = photons::Shooter::new(scene, settings.max_depth, seed);
+    let mut shooter = photons::Shooter::new(scene, settings.max_depth, seed);
     let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     let mut visible = Vec::new();
+    let (mut radii, mut grid) = (Vec::new(), None);
     let mut done = 0u32;
     while done < settings.iterations {
         let iter = done;
@@ -272,9 +273,12 @@ pub fn render(
         };
         counts.rays += pass.run(&mut pixels, &mut visible);
         counts.samples += crop.pixels() as u64;
-        let radii: Vec<f32> = pixels.iter().map(|p| p.radius).collect();
-        if let Some(grid) = grid::Grid::build(&visible, &radii) {
-            let gathered = shooter.shoot(&grid, &visible, &radii, iter, photons);
+        radii.clear();
+        radii.extend(pixels.iter().map(|p| p.radius));
+        // The grid is rebuilt in the last one's buffers.
+        grid = grid::Grid::rebuild(&visible, &radii, grid.take());
+        if let Some(grid) = &grid {
+            let gathered = shooter.shoot(grid, &visible, &radii, iter, photons);
             counts.rays += gathered.rays;
             counts.dropped += gathered.dropped;
             for (i, p) in pixels.iter_mut().enumerate() {

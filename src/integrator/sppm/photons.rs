@@ -12,7 +12,8 @@
 
 use super::grid::Grid;
 use super::visible::VisiblePoint;
-use crate::geometry::{is_valid_radiance, Spectrum, Vec2};
+use crate::bsdf::Bsdf;
+use crate::geometry::{is_valid_radiance, Spectrum, Vec2, Vec3};
 use crate::light::emission::sample_le;
 use crate::lightdistrib::LightPmf;
 use crate::scene::Scene;
@@ -33,6 +34,7 @@ const PRIMES: [u32; 48] = [
 ];
 
 /// What one iteration's photons brought to the visible points.
+#[derive(Default)]
 pub struct Gathered {
     /// Flux at each pixel's visible point (pbrt-v3's `Phi`).
     pub phi: Vec<[f64; 3]>,
@@ -53,6 +55,12 @@ pub struct Shooter<'s> {
     /// Each dimension's shift (Cranley-Patterson rotation) under the seed.
     shifts: [f32; PRIMES.len()],
     seed: u64,
+    /// The last iteration's gatherings (its buffers reused).
+    gathered: Gathered,
+    /// Each pixel's visible point and squared radius, for the lookups.
+    near: Vec<(Vec3, f32)>,
+    /// One round's blocks (their deposit lists reused).
+    pool: Vec<Block>,
 }
 
 /// SplitMix64's finaliser.
@@ -73,6 +81,18 @@ fn unit(h: u64) -> f32 {
 fn radical_inverse<const B: u64>(mut i: u64) -> f32 {
     let inv = 1.0 / B as f64;
     let (mut reversed, mut factor) = (0u64, 1.0f64);
+    // Below 2^32 (every index short of four billion photons) the digits come from 32-bit
+    // divisions, cheaper than 64-bit ones; the digits and so the value are the same.
+    if let Ok(mut j) = u32::try_from(i) {
+        let b = B as u32;
+        while j > 0 {
+            let next = j / b;
+            reversed = reversed * B + u64::from(j - next * b);
+            factor *= inv;
+            j = next;
+        }
+        i = 0;
+    }
     while i > 0 {
         let next = i / B;
         reversed = reversed * B + (i - next * B);
@@ -159,47 +179,64 @@ impl<'s> Shooter<'s> {
             max_depth,
             shifts,
             seed,
+            gathered: Gathered::default(),
+            near: Vec::new(),
+            pool: Vec::new(),
         }
     }
 
     /// Shoots iteration `iter`'s `count` photons at the visible points in `grid` (`visible`
     /// and `radii` by pixel).
     pub fn shoot(
-        &self,
+        &mut self,
         grid: &Grid,
         visible: &[Option<VisiblePoint>],
         radii: &[f32],
         iter: u32,
         count: u64,
-    ) -> Gathered {
-        let mut g = Gathered {
-            phi: vec![[0.0; 3]; visible.len()],
-            m: vec![0; visible.len()],
-            rays: 0,
-            dropped: 0,
-        };
+    ) -> &Gathered {
+        // The buffers are kept from iteration to iteration: allocating, growing and freeing
+        // them each time cost about 3% of a render (perf).
+        let g = &mut self.gathered;
+        g.phi.clear();
+        g.phi.resize(visible.len(), [0.0; 3]);
+        g.m.clear();
+        g.m.resize(visible.len(), 0);
+        (g.rays, g.dropped) = (0, 0);
         if self.scene.lights.is_empty() {
-            return g;
+            return &self.gathered;
         }
+        // Each pixel's visible point and squared radius packed in 16 bytes: the lookups test
+        // distances here instead of in the visible points (about 0.8 kB each, with their
+        // BSDFs), which cache misses made slow. No visible point: a radius that takes nothing.
+        let mut near = std::mem::take(&mut self.near);
+        near.clear();
+        near.extend(visible.iter().zip(radii).map(|(vp, &r)| match vp {
+            Some(vp) => (vp.p, r * r),
+            None => (Vec3::ZERO, f32::NEG_INFINITY),
+        }));
+        let mut pool = std::mem::take(&mut self.pool);
+        pool.resize_with(BLOCKS_PER_ROUND as usize, Block::default);
+        let mut g = std::mem::take(&mut self.gathered);
         let first = u64::from(iter) * count;
         let blocks = count.div_ceil(BLOCK);
         let mut round = 0;
         while round < blocks {
             let end = (round + BLOCKS_PER_ROUND).min(blocks);
-            let traced: Vec<Block> = (round..end)
-                .into_par_iter()
-                .map(|b| {
-                    let mut block = Block::default();
-                    for i in b * BLOCK..((b + 1) * BLOCK).min(count) {
-                        self.trace(first + i, grid, visible, radii, &mut block);
-                    }
-                    block
-                })
-                .collect();
-            for block in traced {
+            let traced = &mut pool[..(end - round) as usize];
+            traced.par_iter_mut().enumerate().for_each(|(k, block)| {
+                block.deposits.clear();
+                (block.rays, block.dropped) = (0, 0);
+                let b = round + k as u64;
+                let mut bsdf = Bsdf::empty();
+                for i in b * BLOCK..((b + 1) * BLOCK).min(count) {
+                    self.trace(first + i, grid, visible, &near, &mut bsdf, block);
+                }
+            });
+            for block in traced.iter() {
                 g.rays += block.rays;
                 g.dropped += block.dropped;
-                for (pixel, phi) in block.deposits {
+                for &(pixel, phi) in &block.deposits {
                     let (s, m) = (&mut g.phi[pixel as usize], &mut g.m[pixel as usize]);
                     s[0] += f64::from(phi.x);
                     s[1] += f64::from(phi.y);
@@ -209,16 +246,19 @@ impl<'s> Shooter<'s> {
             }
             round = end;
         }
-        g
+        (self.near, self.pool, self.gathered) = (near, pool, g);
+        &self.gathered
     }
 
-    /// Traces photon `index` (over all iterations), its deposits added to `block`.
+    /// Traces photon `index` (over all iterations), its deposits added to `block`; `near` is
+    /// each pixel's visible point and squared radius, `bsdf` a BSDF refilled at each hit.
     fn trace(
         &self,
         index: u64,
         grid: &Grid,
         visible: &[Option<VisiblePoint>],
-        radii: &[f32],
+        near: &[(Vec3, f32)],
+        bsdf: &mut Bsdf,
         block: &mut Block,
     ) {
         let scene = self.scene;
@@ -245,20 +285,22 @@ impl<'s> Shooter<'s> {
         let mut pass_through = 0;
         while depth < self.max_depth {
             block.rays += 1;
-            let Some(hit) = scene.intersect(&ray) else {
+            let Some(hit) = scene.closest_hit(&ray) else {
                 break;
             };
-            let si = hit.si;
+            // Made in its local: a hit returned with its interaction was copied (180 bytes).
+            let mut si = scene.interaction(&ray, &hit);
+            let surface = scene.surface_of(&hit);
             if depth > 0 {
                 let wi = -ray.d.normalize();
                 for &pixel in grid.candidates(si.p) {
+                    let (p, r2) = near[pixel as usize];
+                    if p.distance_squared(si.p) > r2 {
+                        continue;
+                    }
                     let Some(vp) = &visible[pixel as usize] else {
                         continue;
                     };
-                    let r = radii[pixel as usize];
-                    if vp.p.distance_squared(si.p) > r * r {
-                        continue;
-                    }
                     let phi = beta * vp.bsdf.f(vp.wo, wi);
                     if is_valid_radiance(phi) {
                         block.deposits.push((pixel, phi));
@@ -267,7 +309,7 @@ impl<'s> Shooter<'s> {
                     }
                 }
             }
-            let Some(material) = hit.surface.material else {
+            let Some(material) = surface.material else {
                 pass_through += 1;
                 if pass_through > MAX_PASS_THROUGH {
                     break;
@@ -276,8 +318,8 @@ impl<'s> Shooter<'s> {
                 continue;
             };
             let material = &scene.materials[material as usize];
-            let si = material.shading(&si);
-            let bsdf = material.bsdf(&si);
+            material.shade(&mut si);
+            material.bsdf_into(&si, bsdf);
             let u = dims.next_2d();
             let u_lobe = dims.next();
             let Some(bs) = bsdf.sample_f(si.wo, u, u_lobe) else {
