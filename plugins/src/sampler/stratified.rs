@@ -259,11 +259,28 @@ mod permutation_tests {
     #[test]
     fn power_of_two_shortcuts_match_the_divisions() {
         for n in (0..31).map(|e| 1u32 << e).chain([3, 5, 6, 7, 12, 100]) {
-            for k in [0u32, 1, 2, 3, 5, 15, 16, 17, 255, 1 << 20, u32::MAX - 1, u32::MAX] {
+            for k in [
+                0u32,
+                1,
+                2,
+                3,
+                5,
+                15,
+                16,
+                17,
+                255,
+                1 << 20,
+                u32::MAX - 1,
+                u32::MAX,
+            ] {
                 assert_eq!(split(k, n), (k % n, k / n), "k {k} n {n}");
                 for j in [0.0f32, 1.0 / (1 << 24) as f32, 0.3, 0.999_999_94] {
                     let x = f64::from(k) + f64::from(j);
-                    assert_eq!(div(x, n).to_bits(), (x / f64::from(n)).to_bits(), "{x} / {n}");
+                    assert_eq!(
+                        div(x, n).to_bits(),
+                        (x / f64::from(n)).to_bits(),
+                        "{x} / {n}"
+                    );
                 }
             }
             if !n.is_power_of_two() {
