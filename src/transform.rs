@@ -204,13 +204,12 @@ impl MotionTransform {
             let mut cache = cache.borrow_mut();
             let c = &mut cache[slot];
             if c.id != self.id || c.time != bits {
-                let at = self.at(time);
-                *c = CachedAt {
-                    id: self.id,
-                    time: bits,
-                    at,
-                    inverse: at.inverse(),
-                };
+                // Field by field, into the slot: a whole `CachedAt` built aside and copied
+                // in was stored in pieces and reloaded at once, which stalls.
+                c.id = self.id;
+                c.time = bits;
+                c.at = self.at(time);
+                c.inverse = c.at.inverse();
             }
             f(&c.at, &c.inverse)
         })
