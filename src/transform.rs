@@ -190,21 +190,28 @@ impl MotionTransform {
     /// The transform at `time` and its inverse, as `at(time)` and `at(time).inverse()` give
     /// them (bit for bit: the same computation, remembered per thread for the last time asked).
     pub fn at_with_inverse(&self, time: f32) -> (Mat4, Mat4) {
+        self.with_at(time, |at, inverse| (*at, *inverse))
+    }
+
+    /// `f` applied to the transform at `time` and its inverse (those of
+    /// [`MotionTransform::at_with_inverse`]) where the per-thread cache holds them: a caller
+    /// that needs a few products of them does not copy 128 bytes out first.
+    #[inline]
+    pub fn with_at<R>(&self, time: f32, f: impl FnOnce(&Mat4, &Mat4) -> R) -> R {
         let slot = (self.id % CACHE_SLOTS as u64) as usize;
         let bits = time.to_bits();
         CACHE.with(|cache| {
             let mut cache = cache.borrow_mut();
             let c = &mut cache[slot];
             if c.id != self.id || c.time != bits {
-                let at = self.at(time);
-                *c = CachedAt {
-                    id: self.id,
-                    time: bits,
-                    at,
-                    inverse: at.inverse(),
-                };
+                // Field by field, into the slot: a whole `CachedAt` built aside and copied
+                // in was stored in pieces and reloaded at once, which stalls.
+                c.id = self.id;
+                c.time = bits;
+                c.at = self.at(time);
+                c.inverse = c.at.inverse();
             }
-            (c.at, c.inverse)
+            f(&c.at, &c.inverse)
         })
     }
 

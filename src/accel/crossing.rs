@@ -30,13 +30,15 @@ impl Accel {
             return self.world.crossing(ray, hit);
         };
         let inst = &self.instances[index as usize];
-        let (to_world, to_local) = inst.placement.at(ray.time);
-        let c = self.objects[inst.object as usize].crossing(&local_ray(ray, &to_local), hit);
-        Crossing {
-            p: to_world.transform_point3(c.p),
-            n: world_normal(&to_local, c.n),
-            p_error: world_p_error(&to_world, c.p_error),
-            time: c.time,
-        }
+        let object = &self.objects[inst.object as usize];
+        inst.placement.with_at(ray.time, |to_world, to_local| {
+            let c = object.crossing(&local_ray(ray, to_local), hit);
+            Crossing {
+                p: to_world.transform_point3(c.p),
+                n: world_normal(to_local, c.n),
+                p_error: world_p_error(to_world, c.p_error),
+                time: c.time,
+            }
+        })
     }
 }

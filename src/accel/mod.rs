@@ -415,10 +415,24 @@ pub enum Placement {
 }
 
 impl Placement {
-    fn at(&self, time: f32) -> (Mat4, Mat4) {
+    /// `f` applied to the world-from-instance matrix at `time` and its inverse, without
+    /// copying a moving transform's out of its cache (`f` must not evaluate moving
+    /// transforms itself: the cache is borrowed while it runs).
+    #[inline]
+    fn with_at<R>(&self, time: f32, f: impl FnOnce(&Mat4, &Mat4) -> R) -> R {
         match self {
-            Placement::Fixed { to_world, to_local } => (*to_world, *to_local),
-            Placement::Moving(m) => m.at_with_inverse(time),
+            Placement::Fixed { to_world, to_local } => f(to_world, to_local),
+            Placement::Moving(m) => m.with_at(time, f),
+        }
+    }
+
+    /// `ray` in the instance's space (at the ray's time for a moving one), computed where
+    /// the moving transform's cache holds the inverse rather than from a copy of it.
+    #[inline]
+    fn local_ray(&self, ray: &Ray) -> Ray {
+        match self {
+            Placement::Fixed { to_local, .. } => local_ray(ray, to_local),
+            Placement::Moving(m) => m.with_at(ray.time, |_, to_local| local_ray(ray, to_local)),
         }
     }
 
@@ -548,8 +562,7 @@ impl Accel {
         tlas.ray_traverse(to_obvhs(ray, t_limit), &mut hit, |r, id| {
             let index = self.tlas_order[id];
             let inst = &self.instances[index as usize];
-            let (_, to_local) = inst.placement.at(ray.time);
-            let local = local_ray(ray, &to_local);
+            let local = inst.placement.local_ray(ray);
             match self.objects[inst.object as usize].intersect_instanced(&local, r.tmax, index) {
                 Some(h) => {
                     best = Some(h);
@@ -571,8 +584,7 @@ impl Accel {
         };
         !tlas.ray_traverse_miss(to_obvhs(ray, t_max), |_, id| {
             let inst = &self.instances[self.tlas_order[id] as usize];
-            let (_, to_local) = inst.placement.at(ray.time);
-            let local = local_ray(ray, &to_local);
+            let local = inst.placement.local_ray(ray);
             if self.objects[inst.object as usize].occluded_instanced(&local, t_max) {
                 0.0
             } else {
@@ -587,9 +599,11 @@ impl Accel {
             return self.world.interaction(ray, hit);
         };
         let inst = &self.instances[index as usize];
-        let (to_world, to_local) = inst.placement.at(ray.time);
-        let si = self.objects[inst.object as usize].interaction(&local_ray(ray, &to_local), hit);
-        transform_interaction(&si, &to_world, &to_local, ray)
+        let object = &self.objects[inst.object as usize];
+        inst.placement.with_at(ray.time, |to_world, to_local| {
+            let si = object.interaction(&local_ray(ray, to_local), hit);
+            transform_interaction(&si, to_world, to_local, ray)
+        })
     }
 }
 

@@ -57,7 +57,33 @@ pub(crate) fn permutation_element(mut i: u32, l: u32, p: u32) -> u32 {
             break;
         }
     }
+    if l.is_power_of_two() {
+        // The sum's low bits: the remainder below, without a 64-bit division.
+        return i.wrapping_add(p) & (l - 1);
+    }
     ((u64::from(i) + u64::from(p)) % u64::from(l)) as u32
+}
+
+/// `(k % n, k / n)` for n >= 1, by a mask and a shift where n is a power of two (the common
+/// strata counts), else by division: the same values either way.
+#[inline]
+fn split(k: u32, n: u32) -> (u32, u32) {
+    if n.is_power_of_two() {
+        (k & (n - 1), k >> n.trailing_zeros())
+    } else {
+        (k % n, k / n)
+    }
+}
+
+/// `x / n` for n >= 1, bit for bit: a product where n is a power of two (its reciprocal is
+/// exact and the product of x >= 2^-24 by it is far above the subnormals), else a division.
+#[inline]
+fn div(x: f64, n: u32) -> f64 {
+    if n.is_power_of_two() {
+        x * f64::from_bits((1023 - u64::from(n.trailing_zeros())) << 52)
+    } else {
+        x / f64::from(n)
+    }
 }
 
 /// A uniform value in [0, 1) from a 64-bit hash (24 bits, so it never rounds to 1).
@@ -119,11 +145,12 @@ impl PixelPattern for StratifiedSampler {
         };
         // Position `j` within stratum `k` of `n`, as an f32 kept inside that stratum.
         let at = |base: u32, k: u32, n: u32, j: f32| {
-            in_stratum(base, k, n, (f64::from(k) + f64::from(j)) / f64::from(n))
+            in_stratum(base, k, n, div(f64::from(k) + f64::from(j), n))
         };
         for index in indices {
             let (k, j) = cell(index, 0);
-            let film = [at(p[0], k % nx, nx, j[0]), at(p[1], k / nx, ny, j[1])];
+            let (kx, ky) = split(k, nx);
+            let film = [at(p[0], kx, nx, j[0]), at(p[1], ky, ny, j[1])];
             // Inactive dims draw nothing: a pinhole still scene pays for x and y only.
             let time = if dims.time {
                 let (k, j) = cell(index, 1);
@@ -133,7 +160,8 @@ impl PixelPattern for StratifiedSampler {
             };
             let lens = if dims.lens {
                 let (k, j) = cell(index, 2);
-                [at(0, k % nx, nx, j[0]), at(0, k / nx, ny, j[1])]
+                let (kx, ky) = split(k, nx);
+                [at(0, kx, nx, j[0]), at(0, ky, ny, j[1])]
             } else {
                 [0.5; 2]
             };
@@ -226,7 +254,45 @@ pub fn square_grid(n: u32) -> (u32, u32) {
 
 #[cfg(test)]
 mod permutation_tests {
-    use super::permutation_element;
+    use super::{div, permutation_element, split};
+
+    #[test]
+    fn power_of_two_shortcuts_match_the_divisions() {
+        for n in (0..31).map(|e| 1u32 << e).chain([3, 5, 6, 7, 12, 100]) {
+            for k in [
+                0u32,
+                1,
+                2,
+                3,
+                5,
+                15,
+                16,
+                17,
+                255,
+                1 << 20,
+                u32::MAX - 1,
+                u32::MAX,
+            ] {
+                assert_eq!(split(k, n), (k % n, k / n), "k {k} n {n}");
+                for j in [0.0f32, 1.0 / (1 << 24) as f32, 0.3, 0.999_999_94] {
+                    let x = f64::from(k) + f64::from(j);
+                    assert_eq!(
+                        div(x, n).to_bits(),
+                        (x / f64::from(n)).to_bits(),
+                        "{x} / {n}"
+                    );
+                }
+            }
+            if !n.is_power_of_two() {
+                continue;
+            }
+            for (i, p) in [(0u32, 0u32), (3, u32::MAX), (7, 0xdead_beef), (1, 1 << 31)] {
+                let i = i % n;
+                let general = ((u64::from(i) + u64::from(p)) % u64::from(n)) as u32;
+                assert_eq!(i.wrapping_add(p) & (n - 1), general);
+            }
+        }
+    }
 
     #[test]
     fn permutation_element_is_a_bijection() {
