@@ -201,6 +201,42 @@ fn object_instances_share_one_definition() {
     ));
 }
 
+/// San Miguel (pbrt-v3-scenes) closes its object definitions as `AttributeEnd` then
+/// `ObjectEnd` inside an outer `AttributeBegin`: pbrt-v3 keeps both blocks on one stack.
+#[test]
+fn crossed_attribute_and_object_blocks_parse_as_in_pbrt_v3() {
+    let d = parse(
+        "WorldBegin\nAttributeBegin\nObjectBegin \"tri\"\nAttributeBegin\nTranslate 0 0 1\n\
+         Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n\
+         AttributeEnd\nAttributeEnd\nObjectEnd\n\
+         AttributeBegin\nTranslate 5 0 0\nObjectInstance \"tri\"\nAttributeEnd\n\
+         Translate 7 0 0\nObjectInstance \"tri\"\nWorldEnd",
+    );
+    assert_eq!(d.objects["tri"].shapes.len(), 1);
+    assert_eq!(d.instances.len(), 2);
+    // Every block was closed: the last instance sees only the Translate after them.
+    assert!(close(
+        point(&d.instances[1].world_from_instance.start, [0.0; 3]),
+        DVec3::new(7.0, 0.0, 0.0)
+    ));
+    let crossed: Vec<_> = d
+        .warnings
+        .iter()
+        .filter(|w| w.to_string().contains("one stack"))
+        .collect();
+    assert_eq!(crossed.len(), 1, "{:?}", d.warnings);
+    assert!(
+        crossed[0].to_string().contains("test.pbrt:8:1"),
+        "{}",
+        crossed[0]
+    );
+    // A stray ObjectEnd is still an error, and so is a TransformEnd crossing either block.
+    assert!(err("WorldBegin\nAttributeBegin\nObjectEnd")
+        .contains("ObjectEnd without a matching ObjectBegin"));
+    assert!(err("WorldBegin\nObjectBegin \"a\"\nTransformEnd")
+        .contains("TransformEnd closes the ObjectBegin"));
+}
+
 #[test]
 fn area_lights_attach_to_shapes_in_scope() {
     let d = parse(

@@ -80,15 +80,36 @@ impl Builder {
                 loc,
                 format!("{end_name} without a matching {}", block.begin_name()),
             )),
-            Some(top) if top.block != block => Err(Error::at(
-                loc,
-                format!(
-                    "{end_name} closes the {} at {}",
-                    top.block.begin_name(),
-                    top.loc
-                ),
-            )),
-            Some(_) => {
+            Some(top)
+                if top.block != block
+                    && !(top.block.saves_attributes() && block.saves_attributes()) =>
+            {
+                Err(Error::at(
+                    loc,
+                    format!(
+                        "{end_name} closes the {} at {}",
+                        top.block.begin_name(),
+                        top.loc
+                    ),
+                ))
+            }
+            Some(top) => {
+                if top.block != block {
+                    // pbrt-v3's ObjectBegin and ObjectEnd are an AttributeBegin and an
+                    // AttributeEnd on one shared stack, and real scenes (San Miguel) cross
+                    // them; see docs/pbrt-v3-compatibility.md.
+                    let message = format!(
+                        "{end_name} closes the {} at {}; accepted, as pbrt-v3 keeps both on one stack",
+                        top.block.begin_name(),
+                        top.loc
+                    );
+                    if self
+                        .warned_once
+                        .insert("crossed attribute and object blocks".to_owned())
+                    {
+                        self.warn(loc, message);
+                    }
+                }
                 if let Some(saved) = self.stack.pop() {
                     if let Some(g) = saved.graphics {
                         self.graphics = g;
@@ -151,6 +172,9 @@ impl Builder {
     /// `ObjectEnd`.
     pub fn object_end(&mut self, loc: &Loc) -> Result<()> {
         self.require_world("ObjectEnd", loc)?;
+        if self.current_object.is_none() {
+            return Err(Error::at(loc, "ObjectEnd without a matching ObjectBegin"));
+        }
         self.pop(Block::Object, "ObjectEnd", loc)?;
         if let Some((name, def)) = self.current_object.take() {
             if let Some(old) = self.scene.objects.get(&name) {

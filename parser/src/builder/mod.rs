@@ -52,6 +52,11 @@ impl Block {
             Block::Object => "ObjectBegin",
         }
     }
+
+    /// Whether the block saves the graphics state (pbrt-v3 pushes both kinds on one stack).
+    fn saves_attributes(self) -> bool {
+        matches!(self, Block::Attribute | Block::Object)
+    }
 }
 
 struct Saved {
