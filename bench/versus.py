@@ -16,13 +16,15 @@ comparison with pbrt-v4.
 
 usage: python3 bench/versus.py [--acr PATH] [--pbrt-v3 PATH] [--pbrt-v4 PATH] [--threads N]
            [--runs N] [--spp N] [--scene FILE ...] [--large DIR] [--no-interiors] [--startup]
-           [--out FILE.md]
+           [--san-miguel DIR] [--out FILE.md]
 With --spp, every renderer reads a copy of the scene (beside it, removed afterwards) whose
 Sampler's "integer pixelsamples" is N; the interiors keep the spp of INTERIOR_SPP whatever --spp.
 Without --scene: scenes/*.pbrt, the pbrt-v3 scenes in ../shared/scenes/pbrt-v3 when present,
 a 1M-triangle mesh written by bench/tools/make_large_scene.py into --large (default
 bench/cache/large), and the interiors of bench/scenes/*.pbrt.gz (decompressed beside them for
-the renderers that read only text; --no-interiors leaves them out). With --startup, each
+the renderers that read only text; --no-interiors leaves them out). --san-miguel DIR adds
+pbrt-v3-scenes' San Miguel (DIR: its sanmiguel/ folder), as bench/tools/make_san_miguel.py
+writes it into bench/cache/san-miguel, at 4 spp. With --startup, each
 renderer also renders one pixel of each scene (--pixelbounds 0,1,0,1, pbrt-v3 excepted: it has
 no such flag): that whole-process time is its start-up (parse, build, output), and the table
 gives it with its share of the full render's time. With --out, the table replaces the text between the markers
@@ -47,7 +49,7 @@ LONG_RUN = 60.0
 BEGIN, END = "<!-- versus:begin -->", "<!-- versus:end -->"
 # The interiors render at the spp the benchmarks' history measured them at (a full 1000x676
 # frame each), whatever --spp asks of the small scenes.
-INTERIOR_SPP = {"conference_room": 8, "theater": 4}
+INTERIOR_SPP = {"conference_room": 8, "theater": 4, "san-miguel": 4}
 ONE_PIXEL = "0,1,0,1"
 RSS_TAG = "versus-peak-kib "
 
@@ -90,7 +92,7 @@ def inlined(path, base, depth=0):
     (relative to `base`, the main file's folder, as pbrt-v3 resolves them)."""
     if depth > 16:
         sys.exit(f"versus.py: {path}: Include nested too deeply")
-    include = re.compile(r'^\s*Include\s+"([^"]+)"\s*$', re.MULTILINE)
+    include = re.compile(r'^[ \t]*Include\s+"([^"]+)"[ \t]*(#[^\n]*)?$', re.MULTILINE)
     text = open(path).read()
     return include.sub(lambda m: inlined(os.path.join(base, m.group(1)), base, depth + 1), text)
 
@@ -209,6 +211,11 @@ def scenes(args):
     found.append(os.path.abspath(large))
     if not args.no_interiors:
         found += sorted(glob.glob(os.path.join(ROOT, "bench", "scenes", "*.pbrt.gz")))
+    if args.san_miguel:
+        out = os.path.join(ROOT, "bench", "cache", "san-miguel")
+        tool = os.path.join(ROOT, "bench", "tools", "make_san_miguel.py")
+        subprocess.run([sys.executable, tool, args.san_miguel, out], check=True)
+        found.append(os.path.join(out, "san-miguel.pbrt"))
     return found
 
 
@@ -289,6 +296,7 @@ def main():
     p.add_argument("--scene", action="append")
     p.add_argument("--large", default=os.path.join(ROOT, "bench", "cache", "large"))
     p.add_argument("--no-interiors", action="store_true")
+    p.add_argument("--san-miguel", metavar="DIR")
     p.add_argument("--startup", action="store_true")
     p.add_argument("--out")
     args = p.parse_args()
