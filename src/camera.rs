@@ -754,10 +754,12 @@ mod tests {
         assert!(e.to_string().contains("c.pbrt:1:1"), "{e}");
     }
 
-    /// A directory holding the double-Gauss lens file and a malformed one.
-    /// (`tag` keeps tests running at once apart.)
+    /// A directory holding the double-Gauss lens file and a malformed one, new for each call
+    /// (tests run at once must not remove each other's).
     fn lens_dir(tag: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("acr-lens-{}-{tag}", std::process::id()));
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("acr-lens-{}-{tag}-{n}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(
             dir.join("dgauss.dat"),
@@ -772,7 +774,9 @@ mod tests {
         let dir = lens_dir(tag);
         let text = format!("Camera \"realistic\" {params}");
         let d = acr_parser::parse_str(&text, &dir.join("c.pbrt")).unwrap();
-        Camera::new(d.camera.as_ref().unwrap(), (32, 32), glam::DMat4::IDENTITY)
+        let camera = Camera::new(d.camera.as_ref().unwrap(), (32, 32), glam::DMat4::IDENTITY);
+        let _ = std::fs::remove_dir_all(&dir);
+        camera
     }
 
     #[test]
@@ -848,6 +852,7 @@ mod tests {
                     Camera \"realistic\" \"string lensfile\" \"dgauss.dat\"";
         let d = acr_parser::parse_str(text, &dir.join("c.pbrt")).unwrap();
         let c = Camera::new(d.camera.as_ref().unwrap(), (32, 32), glam::DMat4::IDENTITY).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
         assert!(c.is_moving());
         let at = |time| {
             c.weighted_ray(&CameraSample { time, ..s }, false)

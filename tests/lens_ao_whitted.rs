@@ -169,6 +169,7 @@ fn a_missing_lens_file_is_a_located_error() {
         .err()
         .expect("built")
         .to_string();
+    let _ = std::fs::remove_dir_all(&dir);
     assert!(e.contains("lens.pbrt:2:20"), "{e}");
     assert!(e.contains("missing.dat"), "{e}");
 }
