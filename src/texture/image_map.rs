@@ -1,9 +1,11 @@
 //! Image maps: converted texels with pbrt-v3's wrap modes and bilinear lookup.
 
+use super::texels::Texels;
 use super::value::TexValue;
 use crate::geometry::{Spectrum, Vec2};
 use crate::image_io::RgbImage;
 use std::fmt::Debug;
+use std::marker::PhantomData;
 
 /// What an image lookup outside [0, 1]² gives (pbrt-v3's `ImageWrap`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -17,13 +19,15 @@ pub enum Wrap {
 }
 
 /// An image ready for lookups: texels already converted (gamma, scale, invert), bottom row
-/// first, so that t = 0 is the bottom of the picture as in pbrt-v3.
+/// first, so that t = 0 is the bottom of the picture as in pbrt-v3. The texels are stored as
+/// `S`: `T`s, or bytes decoded through a table ([`super::texels::ByteTexels`]).
 #[derive(Clone, Debug)]
-pub struct ImageMap<T> {
+pub struct ImageMap<T, S = Vec<T>> {
     width: usize,
     height: usize,
-    texels: Vec<T>,
+    texels: S,
     wrap: Wrap,
+    value: PhantomData<fn() -> T>,
 }
 
 impl<T: TexValue> ImageMap<T> {
@@ -41,22 +45,25 @@ impl<T: TexValue> ImageMap<T> {
                 texels.push(convert(c));
             }
         }
-        Self {
-            width,
-            height,
-            texels,
-            wrap,
-        }
+        Self::from_rows(width, height, texels, wrap)
     }
 
+    /// The texels, row 0 first.
+    pub fn texels(&self) -> &[T] {
+        &self.texels
+    }
+}
+
+impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
     /// From texels already in lookup order (row 0 at t = 0), `width` x `height` of them.
-    pub fn from_rows(width: usize, height: usize, texels: Vec<T>, wrap: Wrap) -> Self {
+    pub fn from_rows(width: usize, height: usize, texels: S, wrap: Wrap) -> Self {
         debug_assert_eq!(texels.len(), width * height);
         Self {
             width,
             height,
             texels,
             wrap,
+            value: PhantomData,
         }
     }
 
@@ -65,8 +72,8 @@ impl<T: TexValue> ImageMap<T> {
         self.wrap
     }
 
-    /// The texels, row 0 first.
-    pub fn texels(&self) -> &[T] {
+    /// The stored texels.
+    pub fn storage(&self) -> &S {
         &self.texels
     }
 
@@ -94,7 +101,7 @@ impl<T: TexValue> ImageMap<T> {
                 (s, t)
             }
         };
-        self.texels[t as usize * self.width + s as usize]
+        self.texels.get(t as usize * self.width + s as usize)
     }
 
     /// Bilinear interpolation at (s, t) in [0, 1]² (pbrt-v3's `MIPMap::triangle` at level 0).

@@ -27,8 +27,11 @@ use std::sync::Arc;
 mod builder;
 pub mod image_map;
 mod mapping;
+pub mod pyramid;
+pub mod source;
 #[cfg(test)]
 mod tests;
+pub mod texels;
 pub mod value;
 
 pub use builder::TextureBuilder;
