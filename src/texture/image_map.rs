@@ -27,6 +27,8 @@ pub struct ImageMap<T, S = Vec<T>> {
     height: usize,
     texels: S,
     wrap: Wrap,
+    /// Both sides powers of two (every MIP level's): repeating is a mask.
+    pow2: bool,
     value: PhantomData<fn() -> T>,
 }
 
@@ -63,6 +65,7 @@ impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
             height,
             texels,
             wrap,
+            pow2: width.is_power_of_two() && height.is_power_of_two(),
             value: PhantomData,
         }
     }
@@ -92,6 +95,8 @@ impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
     pub fn texel(&self, s: i64, t: i64) -> T {
         let (w, h) = (self.width as i64, self.height as i64);
         let (s, t) = match self.wrap {
+            // The mask is the Euclidean remainder by a power of two, without a division.
+            Wrap::Repeat if self.pow2 => (s & (w - 1), t & (h - 1)),
             Wrap::Repeat => (s.rem_euclid(w), t.rem_euclid(h)),
             Wrap::Clamp => (s.clamp(0, w - 1), t.clamp(0, h - 1)),
             Wrap::Black => {
