@@ -66,7 +66,7 @@ pub fn read_image(path: &Path, srgb: bool) -> Result<RgbImage, String> {
 
 /// The bytes of an image file, through the checked reader every file a scene names goes
 /// through (a regular file of bounded size).
-fn read_image_file(path: &Path) -> Result<Vec<u8>, String> {
+pub(crate) fn read_image_file(path: &Path) -> Result<Vec<u8>, String> {
     acr_parser::source::read_file(path, acr_parser::source::FileKind::Image)
         .map_err(|e| acr_parser::io_message(&e))
 }

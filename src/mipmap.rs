@@ -1,11 +1,16 @@
 //! pbrt-v3's `MIPMap` (core/mipmap.h) for image textures: an image whose sides are not powers
 //! of two is resampled up to them (a Lanczos-windowed sinc, 4 taps, clamped at 0), each level
-//! halves the one below by a box filter, and lookups filter over the hit's footprint, EWA
-//! (a Gaussian over the footprint's ellipse, its eccentricity capped at `maxanisotropy`) by
-//! default or trilinear on request. Without a footprint (rays after the first bounce) a lookup
-//! is bilinear in the first level, as pbrt-v3's.
+//! halves the one below by a box filter ([`crate::texture::pyramid`]), and lookups filter over
+//! the hit's footprint, EWA (a Gaussian over the footprint's ellipse, its eccentricity capped at
+//! `maxanisotropy`) by default or trilinear on request. Without a footprint (rays after the
+//! first bounce) a lookup is bilinear in the first level, as pbrt-v3's. The levels of an 8-bit
+//! image are kept in bytes, as pbrt-v4 keeps them (docs/pbrt-v3-compatibility.md, "Materials
+//! and textures").
 
 use crate::texture::image_map::{ImageMap, Wrap};
+use crate::texture::pyramid::{build_levels, quantise, resample_up};
+use crate::texture::source::ByteImage;
+use crate::texture::texels::{ByteTexels, Quantiser, Texels};
 use crate::texture::value::TexValue;
 use glam::Vec2;
 
@@ -23,79 +28,20 @@ fn weight_lut() -> &'static [f32; WEIGHT_LUT_SIZE] {
     })
 }
 
-/// pbrt-v3's `Lanczos(x, tau = 2)`.
-fn lanczos(x: f32) -> f32 {
-    let x = x.abs();
-    if x < 1e-5 {
-        return 1.0;
-    }
-    if x > 1.0 {
-        return 0.0;
-    }
-    let x = x * std::f32::consts::PI;
-    let tau = 2.0;
-    ((x * tau).sin() / (x * tau)) * (x.sin() / x)
-}
-
-/// pbrt-v3's `resampleWeights`: per new texel, its first old texel and four weights.
-fn resample_weights(old: usize, new: usize) -> Vec<(i64, [f32; 4])> {
-    let filter_width = 2.0f32;
-    (0..new)
-        .map(|i| {
-            let center = (i as f32 + 0.5) * old as f32 / new as f32;
-            let first = ((center - filter_width) + 0.5).floor() as i64;
-            let mut w: [f32; 4] = std::array::from_fn(|j| {
-                lanczos((first as f32 + j as f32 + 0.5 - center) / filter_width)
-            });
-            let inv = 1.0 / (w[0] + w[1] + w[2] + w[3]);
-            for v in &mut w {
-                *v *= inv;
-            }
-            (first, w)
-        })
-        .collect()
-}
-
-/// `lines` lines of `old` texels each (texel i of line l is `at(l, i)`) resampled to `new`
-/// texels with pbrt-v3's weights, line after line.
-fn resample_lines<T: TexValue>(
-    at: impl Fn(usize, usize) -> T,
-    lines: usize,
-    old: usize,
-    new: usize,
-    wrap: Wrap,
-) -> Vec<T> {
-    let weights = resample_weights(old, new);
-    let mut out = Vec::with_capacity(lines * new);
-    for l in 0..lines {
-        for (first, w) in &weights {
-            let mut v = T::ZERO;
-            for (j, &wt) in w.iter().enumerate() {
-                if let Some(o) = wrap_index(first + j as i64, old, wrap) {
-                    v = v + at(l, o) * wt;
-                }
-            }
-            out.push(v);
-        }
-    }
-    out
-}
-
-/// Where texel `i` of a `size`-texel row lies after wrapping (`None`: black, outside).
-fn wrap_index(i: i64, size: usize, wrap: Wrap) -> Option<usize> {
-    let n = size as i64;
-    match wrap {
-        Wrap::Repeat => Some(i.rem_euclid(n) as usize),
-        Wrap::Clamp => Some(i.clamp(0, n - 1) as usize),
-        Wrap::Black => (0..n).contains(&i).then_some(i as usize),
-    }
+/// A pyramid's levels, finest first, in the storage they were built in.
+#[derive(Clone, Debug)]
+enum Pyramid<T> {
+    /// Texels as values.
+    Values(Vec<ImageMap<T>>),
+    /// Texels as bytes through a table.
+    Bytes(Vec<ImageMap<T, ByteTexels>>),
 }
 
 /// An image pyramid with pbrt-v3's lookups.
 #[derive(Clone, Debug)]
 pub struct MipMap<T> {
     /// Level 0 (the image, resampled to powers of two) up to 1 x 1.
-    levels: Vec<ImageMap<T>>,
+    levels: Pyramid<T>,
     /// Trilinear filtering instead of EWA.
     trilinear: bool,
     /// The largest ratio of the footprint's axes EWA keeps.
@@ -103,46 +49,58 @@ pub struct MipMap<T> {
 }
 
 impl<T: TexValue> MipMap<T> {
-    /// The pyramid of `image` (a resampled texel is kept non-negative: pbrt-v3 clamps what the
-    /// Lanczos lobes make negative).
+    /// The pyramid of `image`, its texels kept as values.
     pub fn new(image: &ImageMap<T>, trilinear: bool, max_anisotropy: f32) -> Self {
-        let wrap = image.wrap();
-        let (w, h) = (image.width(), image.height());
-        let base = if w.is_power_of_two() && h.is_power_of_two() {
-            image.clone()
+        Self::from_image(image.clone(), trilinear, max_anisotropy)
+    }
+
+    /// [`MipMap::new`], taking the image.
+    pub fn from_image(image: ImageMap<T>, trilinear: bool, max_anisotropy: f32) -> Self {
+        let base = if image.width().is_power_of_two() && image.height().is_power_of_two() {
+            image
         } else {
-            let (w2, h2) = (w.next_power_of_two(), h.next_power_of_two());
-            let texels = image.texels();
-            // Along s, row by row; then along t, column by column, clamped.
-            let wide = resample_lines(|t, s| texels[t * w + s], h, w, w2, wrap);
-            let tall = resample_lines(|s, t| wide[t * w2 + s], w2, h, h2, wrap);
-            let mut out = vec![T::ZERO; w2 * h2];
-            for s in 0..w2 {
-                for t in 0..h2 {
-                    out[t * w2 + s] = tall[s * h2 + t].clamp_nonneg();
-                }
-            }
-            ImageMap::from_rows(w2, h2, out, wrap)
+            resample_up(&image)
         };
-        let count = 1 + base.width().max(base.height()).ilog2() as usize;
-        let mut levels = vec![base];
-        for _ in 1..count {
-            let below = levels.last().expect("level 0 is there");
-            let (sw, th) = ((below.width() / 2).max(1), (below.height() / 2).max(1));
-            let mut texels = Vec::with_capacity(sw * th);
-            for t in 0..th as i64 {
-                for s in 0..sw as i64 {
-                    let sum = below.texel(2 * s, 2 * t)
-                        + below.texel(2 * s + 1, 2 * t)
-                        + below.texel(2 * s, 2 * t + 1)
-                        + below.texel(2 * s + 1, 2 * t + 1);
-                    texels.push(sum * 0.25);
-                }
-            }
-            levels.push(ImageMap::from_rows(sw, th, texels, wrap));
-        }
+        let mut levels = Vec::new();
+        build_levels(base, |level| levels.push(level));
         Self {
-            levels,
+            levels: Pyramid::Values(levels),
+            trilinear,
+            max_anisotropy,
+        }
+    }
+
+    /// The pyramid of an 8-bit image whose byte `b` is worth `lut[b]`, kept in bytes: levels
+    /// are built in floats exactly as [`MipMap::new`] builds them, then each is stored as the
+    /// bytes `quantiser` finds nearest, but for a level 0 that is the image's own pixels, kept
+    /// as they are. A grey image's bytes make every channel of a colour texel.
+    pub fn from_bytes(
+        image: &ByteImage,
+        lut: &[f32; 256],
+        quantiser: &Quantiser,
+        wrap: Wrap,
+        trilinear: bool,
+        max_anisotropy: f32,
+    ) -> Self {
+        let values = image.to_map(wrap, |b| T::from_bytes(b, lut));
+        let own = image.width.is_power_of_two() && image.height.is_power_of_two();
+        let base = if own { values } else { resample_up(&values) };
+        let mut levels = Vec::new();
+        build_levels(base, |level| {
+            let stored = if own && levels.is_empty() {
+                let mut data = Vec::with_capacity(image.data.len());
+                for t in 0..image.height {
+                    data.extend_from_slice(image.row_from_bottom(t));
+                }
+                let texels = ByteTexels::new(data, image.channels, *lut);
+                ImageMap::from_rows(image.width, image.height, texels, wrap)
+            } else {
+                quantise(&level, image.channels, quantiser, lut)
+            };
+            levels.push(stored);
+        });
+        Self {
+            levels: Pyramid::Bytes(levels),
             trilinear,
             max_anisotropy,
         }
@@ -150,28 +108,72 @@ impl<T: TexValue> MipMap<T> {
 
     /// The finest level's width and height (the image's, raised to powers of two).
     pub fn size(&self) -> (usize, usize) {
-        (self.levels[0].width(), self.levels[0].height())
+        match &self.levels {
+            Pyramid::Values(l) => (l[0].width(), l[0].height()),
+            Pyramid::Bytes(l) => (l[0].width(), l[0].height()),
+        }
     }
 
     /// The number of levels.
     pub fn levels(&self) -> usize {
-        self.levels.len()
+        match &self.levels {
+            Pyramid::Values(l) => l.len(),
+            Pyramid::Bytes(l) => l.len(),
+        }
     }
 
-    /// Bilinear lookup in `level` (pbrt-v3's `triangle`).
-    fn triangle(&self, level: usize, st: Vec2) -> T {
-        self.levels[level.min(self.levels.len() - 1)].bilerp(st)
+    /// Whether the texels are kept in bytes.
+    pub fn in_bytes(&self) -> bool {
+        matches!(self.levels, Pyramid::Bytes(_))
     }
 
-    /// The texel that stands for the whole image: the top level's.
-    fn top(&self) -> T {
-        self.levels[self.levels.len() - 1].texel(0, 0)
+    /// Bytes the texels take.
+    pub fn texel_bytes(&self) -> usize {
+        match &self.levels {
+            Pyramid::Values(l) => {
+                l.iter().map(|m| m.texels().len()).sum::<usize>() * size_of::<T>()
+            }
+            Pyramid::Bytes(l) => l.iter().map(|m| m.storage().bytes()).sum(),
+        }
     }
 
     /// pbrt-v3's trilinear lookup over a square footprint `width` wide (its
     /// `MIPMap::Lookup(st, width)`).
     pub fn lookup_width(&self, st: Vec2, width: f32) -> T {
-        let n = self.levels.len();
+        match &self.levels {
+            Pyramid::Values(l) => Levels(l).lookup_width(st, width),
+            Pyramid::Bytes(l) => Levels(l).lookup_width(st, width),
+        }
+    }
+
+    /// The filtered value at `st` over the footprint `dst0`, `dst1` (pbrt-v3's
+    /// `MIPMap::Lookup(st, dstdx, dstdy)`).
+    pub fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
+        let (trilinear, max_anisotropy) = (self.trilinear, self.max_anisotropy);
+        match &self.levels {
+            Pyramid::Values(l) => Levels(l).lookup(st, dst0, dst1, trilinear, max_anisotropy),
+            Pyramid::Bytes(l) => Levels(l).lookup(st, dst0, dst1, trilinear, max_anisotropy),
+        }
+    }
+}
+
+/// A pyramid's levels in one storage, with the lookups.
+struct Levels<'a, T, S>(&'a [ImageMap<T, S>]);
+
+impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
+    /// Bilinear lookup in `level` (pbrt-v3's `triangle`).
+    fn triangle(&self, level: usize, st: Vec2) -> T {
+        self.0[level.min(self.0.len() - 1)].bilerp(st)
+    }
+
+    /// The texel that stands for the whole image: the top level's.
+    fn top(&self) -> T {
+        self.0[self.0.len() - 1].texel(0, 0)
+    }
+
+    /// See [`MipMap::lookup_width`].
+    fn lookup_width(&self, st: Vec2, width: f32) -> T {
+        let n = self.0.len();
         let level = n as f32 - 1.0 + width.max(1e-8).log2();
         if level < 0.0 {
             self.triangle(0, st)
@@ -184,13 +186,12 @@ impl<T: TexValue> MipMap<T> {
         }
     }
 
-    /// The filtered value at `st` over the footprint `dst0`, `dst1` (pbrt-v3's
-    /// `MIPMap::Lookup(st, dstdx, dstdy)`).
-    pub fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
+    /// See [`MipMap::lookup`].
+    fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2, trilinear: bool, max_anisotropy: f32) -> T {
         if !(dst0.is_finite() && dst1.is_finite()) {
             return self.triangle(0, st);
         }
-        if self.trilinear {
+        if trilinear {
             let width = dst0.abs().max_element().max(dst1.abs().max_element());
             return self.lookup_width(st, width);
         }
@@ -200,15 +201,15 @@ impl<T: TexValue> MipMap<T> {
         }
         let major_length = major.length();
         let mut minor_length = minor.length();
-        if minor_length * self.max_anisotropy < major_length && minor_length > 0.0 {
-            let scale = major_length / (minor_length * self.max_anisotropy);
+        if minor_length * max_anisotropy < major_length && minor_length > 0.0 {
+            let scale = major_length / (minor_length * max_anisotropy);
             minor *= scale;
             minor_length *= scale;
         }
         if minor_length == 0.0 {
             return self.triangle(0, st);
         }
-        let lod = (self.levels.len() as f32 - 1.0 + minor_length.log2()).max(0.0);
+        let lod = (self.0.len() as f32 - 1.0 + minor_length.log2()).max(0.0);
         let i = lod.floor() as usize;
         let d = lod - i as f32;
         self.ewa(i, st, major, minor) * (1.0 - d) + self.ewa(i + 1, st, major, minor) * d
@@ -216,7 +217,7 @@ impl<T: TexValue> MipMap<T> {
 
     /// pbrt-v3's EWA filter at one level.
     fn ewa(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
-        let Some(map) = self.levels.get(level) else {
+        let Some(map) = self.0.get(level) else {
             return self.top();
         };
         let size = Vec2::new(map.width() as f32, map.height() as f32);

@@ -1,7 +1,6 @@
 //! Building textures from a scene description, on demand, each once (`TextureBuilder`).
 
 use crate::geometry::Spectrum;
-use crate::image_io::{read_image, RgbImage};
 use crate::mipmap::MipMap;
 use crate::procedural::NoisePattern;
 use acr_parser::{
@@ -15,6 +14,8 @@ use std::fmt::Debug;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use super::source::{read_source, ByteImage, Source};
+use super::texels::Quantiser;
 use super::*;
 
 /// The texture classes pbrt-v3 has that acr does not implement (pbrt-v3 builds `ptex` only
@@ -89,13 +90,19 @@ struct ImageKey {
 }
 
 /// Builds textures on demand from a scene description's texture definitions, each at most once,
-/// reading each image file at most once; collects warnings (each kind once).
+/// building each image map's MIP map once; collects warnings (each kind once). A decoded image
+/// file is kept only until the next file is read: the MIP maps are what stays.
 pub struct TextureBuilder<'a> {
     desc: &'a SceneDescription,
     main_dir: PathBuf,
     pub(super) floats: Vec<Option<Arc<FloatTexture>>>,
     spectra: Vec<Option<Arc<SpectrumTexture>>>,
-    files: HashMap<PathBuf, Arc<RgbImage>>,
+    /// The image files read so far.
+    files: HashSet<PathBuf>,
+    /// The last file decoded, for the next map of the same file.
+    last_file: Option<(PathBuf, Arc<Source>)>,
+    /// Quantisers by their table's bits (most textures share the sRGB one).
+    quantisers: HashMap<[u32; 256], Arc<Quantiser>>,
     float_maps: HashMap<ImageKey, Arc<MipMap<f32>>>,
     spectrum_maps: HashMap<ImageKey, Arc<MipMap<Spectrum>>>,
     warned: HashSet<String>,
@@ -169,7 +176,9 @@ impl<'a> TextureBuilder<'a> {
             main_dir: main_dir.to_path_buf(),
             floats: vec![None; n],
             spectra: vec![None; n],
-            files: HashMap::new(),
+            files: HashSet::new(),
+            last_file: None,
+            quantisers: HashMap::new(),
             float_maps: HashMap::new(),
             spectrum_maps: HashMap::new(),
             warned: HashSet::new(),
@@ -555,23 +564,66 @@ impl<'a> TextureBuilder<'a> {
         if let Some(m) = T::maps(self).get(&key) {
             return Ok(Arc::clone(m));
         }
-        let img = match self.files.get(&key_path) {
-            Some(img) => Arc::clone(img),
-            None => {
-                let img = read_image(&path, false).map_err(|e| {
+        let src = match &self.last_file {
+            Some((p, src)) if *p == key_path => Arc::clone(src),
+            _ => {
+                // The previous file goes first, so that two decoded files never coexist.
+                self.last_file = None;
+                let src = read_source(&path).map_err(|e| {
                     Error::at(
                         &at,
                         format!("cannot read image \"{}\": {e}", path.display()),
                     )
                 })?;
-                let img = Arc::new(img);
-                self.files.insert(key_path, Arc::clone(&img));
-                img
+                let src = Arc::new(src);
+                self.files.insert(key_path.clone());
+                self.last_file = Some((key_path, Arc::clone(&src)));
+                src
             }
         };
-        let map = ImageMap::new(&img, wrap, |c| T::from_texel(c, scale, gamma, invert));
-        let map = Arc::new(MipMap::new(&map, trilinear, max_anisotropy));
+        let convert = |c| T::from_texel(c, scale, gamma, invert);
+        let map = Arc::new(match &*src {
+            Source::Values(img) => {
+                MipMap::from_image(ImageMap::new(img, wrap, convert), trilinear, max_anisotropy)
+            }
+            Source::Bytes(img) => byte_mipmap::<T>(
+                img,
+                convert,
+                &mut self.quantisers,
+                wrap,
+                (trilinear, max_anisotropy),
+            ),
+        });
         T::maps(self).insert(key, Arc::clone(&map));
         Ok(map)
+    }
+}
+
+/// The MIP map of an 8-bit image whose pixels `convert` turns into texels: kept in bytes
+/// ([`MipMap::from_bytes`]) where a byte's texel value is one table entry (a colour texture, or
+/// a grey image; the conversion's table monotone), else in values.
+fn byte_mipmap<T: Build>(
+    img: &ByteImage,
+    convert: impl Fn(Spectrum) -> T,
+    quantisers: &mut HashMap<[u32; 256], Arc<Quantiser>>,
+    wrap: Wrap,
+    (trilinear, max_anisotropy): (bool, f32),
+) -> MipMap<T> {
+    let unit = img.unit;
+    let lut: [f32; 256] = std::array::from_fn(|b| convert(Spectrum::splat(unit[b])).channel(0));
+    let per_channel = img.channels == 1 || T::kind() == TextureValue::Spectrum;
+    let quantiser = match quantisers.entry(lut.map(f32::to_bits)) {
+        std::collections::hash_map::Entry::Occupied(e) => Some(Arc::clone(e.get())),
+        std::collections::hash_map::Entry::Vacant(e) => {
+            Quantiser::new(&lut).map(|q| Arc::clone(e.insert(Arc::new(q))))
+        }
+    };
+    match quantiser.filter(|_| per_channel) {
+        Some(q) => MipMap::from_bytes(img, &lut, &q, wrap, trilinear, max_anisotropy),
+        None => MipMap::from_image(
+            img.to_map(wrap, |b| convert(img.rgb(b))),
+            trilinear,
+            max_anisotropy,
+        ),
     }
 }

@@ -1,9 +1,11 @@
 //! Image maps: converted texels with pbrt-v3's wrap modes and bilinear lookup.
 
+use super::texels::Texels;
 use super::value::TexValue;
 use crate::geometry::{Spectrum, Vec2};
 use crate::image_io::RgbImage;
 use std::fmt::Debug;
+use std::marker::PhantomData;
 
 /// What an image lookup outside [0, 1]² gives (pbrt-v3's `ImageWrap`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -17,13 +19,17 @@ pub enum Wrap {
 }
 
 /// An image ready for lookups: texels already converted (gamma, scale, invert), bottom row
-/// first, so that t = 0 is the bottom of the picture as in pbrt-v3.
+/// first, so that t = 0 is the bottom of the picture as in pbrt-v3. The texels are stored as
+/// `S`: `T`s, or bytes decoded through a table ([`super::texels::ByteTexels`]).
 #[derive(Clone, Debug)]
-pub struct ImageMap<T> {
+pub struct ImageMap<T, S = Vec<T>> {
     width: usize,
     height: usize,
-    texels: Vec<T>,
+    texels: S,
     wrap: Wrap,
+    /// Both sides powers of two (every MIP level's): repeating is a mask.
+    pow2: bool,
+    value: PhantomData<fn() -> T>,
 }
 
 impl<T: TexValue> ImageMap<T> {
@@ -41,22 +47,26 @@ impl<T: TexValue> ImageMap<T> {
                 texels.push(convert(c));
             }
         }
-        Self {
-            width,
-            height,
-            texels,
-            wrap,
-        }
+        Self::from_rows(width, height, texels, wrap)
     }
 
+    /// The texels, row 0 first.
+    pub fn texels(&self) -> &[T] {
+        &self.texels
+    }
+}
+
+impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
     /// From texels already in lookup order (row 0 at t = 0), `width` x `height` of them.
-    pub fn from_rows(width: usize, height: usize, texels: Vec<T>, wrap: Wrap) -> Self {
+    pub fn from_rows(width: usize, height: usize, texels: S, wrap: Wrap) -> Self {
         debug_assert_eq!(texels.len(), width * height);
         Self {
             width,
             height,
             texels,
             wrap,
+            pow2: width.is_power_of_two() && height.is_power_of_two(),
+            value: PhantomData,
         }
     }
 
@@ -65,8 +75,8 @@ impl<T: TexValue> ImageMap<T> {
         self.wrap
     }
 
-    /// The texels, row 0 first.
-    pub fn texels(&self) -> &[T] {
+    /// The stored texels.
+    pub fn storage(&self) -> &S {
         &self.texels
     }
 
@@ -85,6 +95,8 @@ impl<T: TexValue> ImageMap<T> {
     pub fn texel(&self, s: i64, t: i64) -> T {
         let (w, h) = (self.width as i64, self.height as i64);
         let (s, t) = match self.wrap {
+            // The mask is the Euclidean remainder by a power of two, without a division.
+            Wrap::Repeat if self.pow2 => (s & (w - 1), t & (h - 1)),
             Wrap::Repeat => (s.rem_euclid(w), t.rem_euclid(h)),
             Wrap::Clamp => (s.clamp(0, w - 1), t.clamp(0, h - 1)),
             Wrap::Black => {
@@ -94,7 +106,7 @@ impl<T: TexValue> ImageMap<T> {
                 (s, t)
             }
         };
-        self.texels[t as usize * self.width + s as usize]
+        self.texels.get(t as usize * self.width + s as usize)
     }
 
     /// Bilinear interpolation at (s, t) in [0, 1]² (pbrt-v3's `MIPMap::triangle` at level 0).

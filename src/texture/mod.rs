@@ -5,8 +5,8 @@
 //! reference) into a texture.
 //!
 //! Textures are built lazily, when a material that renders refers to them ([`TextureBuilder`]);
-//! each texture description is built once and shared, and each image file is read once.
-//! Evaluation allocates nothing.
+//! each texture description is built once and shared, and each image map's MIP map once (an
+//! 8-bit PNG's levels kept in bytes, `texels`). Evaluation allocates nothing.
 //!
 //! Camera-ray hits carry their footprint (the ray differentials, `SurfaceInteraction::diff`):
 //! the mappings turn it into (s, t) derivatives as pbrt-v3's do, image maps filter their MIP
@@ -27,8 +27,11 @@ use std::sync::Arc;
 mod builder;
 pub mod image_map;
 mod mapping;
+pub mod pyramid;
+pub mod source;
 #[cfg(test)]
 mod tests;
+pub mod texels;
 pub mod value;
 
 pub use builder::TextureBuilder;

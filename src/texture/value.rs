@@ -29,6 +29,10 @@ pub trait TexValue:
     fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self;
     /// The value with negative parts set to 0.
     fn clamp_nonneg(self) -> Self;
+    /// A texel stored as bytes (1, or 3 for a colour), each byte's value being `lut[byte]`.
+    fn from_bytes(bytes: &[u8], lut: &[f32; 256]) -> Self;
+    /// Channel `c` (0 for a float; 0, 1, 2 for a colour's).
+    fn channel(self, c: usize) -> f32;
 }
 
 impl TexValue for f32 {
@@ -41,6 +45,15 @@ impl TexValue for f32 {
 
     fn clamp_nonneg(self) -> Self {
         self.max(0.0)
+    }
+
+    #[inline]
+    fn from_bytes(bytes: &[u8], lut: &[f32; 256]) -> Self {
+        lut[bytes[0] as usize]
+    }
+
+    fn channel(self, _c: usize) -> f32 {
+        self
     }
 
     fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self {
@@ -64,6 +77,18 @@ impl TexValue for Spectrum {
 
     fn clamp_nonneg(self) -> Self {
         self.max(Spectrum::ZERO)
+    }
+
+    #[inline]
+    fn from_bytes(bytes: &[u8], lut: &[f32; 256]) -> Self {
+        match bytes {
+            [r, g, b] => Spectrum::new(lut[*r as usize], lut[*g as usize], lut[*b as usize]),
+            _ => Spectrum::splat(lut[bytes[0] as usize]),
+        }
+    }
+
+    fn channel(self, c: usize) -> f32 {
+        self[c]
     }
 
     fn from_texel(rgb: Spectrum, scale: f32, gamma: bool, invert: bool) -> Self {
