@@ -137,6 +137,11 @@ impl Geometry {
         self.prims.push(prim);
     }
 
+    /// Adds many primitives at once, in order (call [`Geometry::build`] after the last).
+    pub fn extend(&mut self, prims: impl IndexedParallelIterator<Item = Prim>) {
+        self.prims.par_extend(prims);
+    }
+
     /// Number of primitives.
     pub fn len(&self) -> usize {
         self.prims.len()

@@ -96,6 +96,9 @@ pub fn build_wide(count: usize, bounds: impl Fn(usize) -> Aabb + Sync) -> CwBvh 
     }
 }
 
+/// Sets of at least this many primitives are binned on every thread.
+const PARALLEL_BINS: usize = if cfg!(test) { 64 } else { 1 << 16 };
+
 /// Sets of more primitives than this have their inner children built in parallel (few in tests,
 /// so that small test scenes take the parallel path too).
 const PARALLEL_MIN: usize = if cfg!(test) { 64 } else { 1 << 15 };
@@ -281,20 +284,17 @@ impl Builder<'_> {
             // last bin through the `min`.
             (((c - min) * scale) as usize).min(BINS - 1)
         };
-        // Two sets of bins, for alternate items, merged after: consecutive items (neighbours in
-        // a mesh) mostly fall in one bin, and one set made each update wait for the last.
-        let mut twin = [[(Aabb::empty(), 0u32); BINS]; 2];
-        for pair in self.items[set.start..set.end].chunks(2) {
-            for (bins, it) in twin.iter_mut().zip(pair) {
-                let bin = &mut bins[bin_of(it)];
-                bin.0 = bin.0.union(&it.aabb());
-                bin.1 += 1;
-            }
-        }
-        let mut bins = twin[0];
-        for (bin, other) in bins.iter_mut().zip(&twin[1]) {
-            *bin = (bin.0.union(&other.0), bin.1 + other.1);
-        }
+        let items = &self.items[set.start..set.end];
+        // The top levels' sets are binned on every thread, in chunks of a fixed size: a bin's
+        // box is a min and max and its count a sum, so any grouping gives the same bins.
+        let bins = if items.len() >= PARALLEL_BINS {
+            items
+                .par_chunks(PARALLEL_BINS / 4)
+                .map(|chunk| bin_items(chunk, bin_of))
+                .reduce(|| [(Aabb::empty(), 0u32); BINS], merge_bins)
+        } else {
+            bin_items(items, bin_of)
+        };
         // Cost of each plane (after bin k): area times count on both sides.
         let mut right = [(Aabb::empty(), 0u32); BINS];
         let mut acc = (Aabb::empty(), 0u32);
@@ -392,6 +392,30 @@ impl Builder<'_> {
             set_of(self.items, mid, set.end),
         )
     }
+}
+
+/// The boxes and counts of `items` in the bins `bin_of` gives.
+#[inline]
+fn bin_items(items: &[Item], bin_of: impl Fn(&Item) -> usize) -> [(Aabb, u32); BINS] {
+    // Two sets of bins, for alternate items, merged after: consecutive items (neighbours in a
+    // mesh) mostly fall in one bin, and one set made each update wait for the last.
+    let mut twin = [[(Aabb::empty(), 0u32); BINS]; 2];
+    for pair in items.chunks(2) {
+        for (bins, it) in twin.iter_mut().zip(pair) {
+            let bin = &mut bins[bin_of(it)];
+            bin.0 = bin.0.union(&it.aabb());
+            bin.1 += 1;
+        }
+    }
+    merge_bins(twin[0], twin[1])
+}
+
+/// Two sets of bins over disjoint items, as one.
+fn merge_bins(mut a: [(Aabb, u32); BINS], b: [(Aabb, u32); BINS]) -> [(Aabb, u32); BINS] {
+    for (bin, other) in a.iter_mut().zip(&b) {
+        *bin = (bin.0.union(&other.0), bin.1 + other.1);
+    }
+    a
 }
 
 /// Half the surface area of a box, zero for an empty one.

@@ -8,7 +8,13 @@ use crate::geometry::Vec3;
 use crate::shapes::{Cylinder, Disk, Sphere, Transform, TriangleMesh};
 use acr_parser::{PluginDesc, Result, ShapeDesc, Warning};
 use glam::DMat4;
+use rayon::prelude::*;
 use std::sync::Arc;
+
+/// Shapes of at least this many primitives are checked on every thread (a parallel call costs
+/// microseconds, and a scene may have thousands of small shapes).
+const PARALLEL_MIN: usize = 1 << 14;
+
 /// Shape types pbrt-v3 has and acr does not: warned about once and skipped.
 const UNSUPPORTED_SHAPES: &[&str] = &[];
 /// A transform and its inverse from a double-precision matrix.
@@ -69,19 +75,23 @@ impl Builder<'_> {
         let mesh_index = geom.meshes.len() as u32;
         let n = tm.triangle_count();
         let before = prims.len();
-        prims.extend(
-            (0..n)
-                .filter(|&tri| {
-                    // The intersection test's own zero-area test, and finite vertices.
-                    let [a, b, c] = tm.vertices(tri);
-                    let n = (a - c).cross(b - c);
-                    n != Vec3::ZERO && n.is_finite()
-                })
-                .map(|tri| PrimKind::Triangle {
-                    mesh: mesh_index,
-                    tri: tri as u32,
-                }),
-        );
+        // The intersection test's own zero-area test, and finite vertices.
+        let fine = |tri: usize| {
+            let [a, b, c] = tm.vertices(tri);
+            let n = (a - c).cross(b - c);
+            n != Vec3::ZERO && n.is_finite()
+        };
+        let prim = |tri: usize| PrimKind::Triangle {
+            mesh: mesh_index,
+            tri: tri as u32,
+        };
+        // A large mesh's triangles on every thread (a million took 15 ms on one); rayon's
+        // collect keeps their order.
+        if n >= PARALLEL_MIN && (0..n).into_par_iter().all(fine) {
+            prims.par_extend((0..n).into_par_iter().map(prim));
+        } else {
+            prims.extend((0..n).filter(|&tri| fine(tri)).map(prim));
+        }
         let skipped = n - (prims.len() - before);
         if skipped > 0 {
             self.warnings.push(Warning::at(
@@ -376,10 +386,15 @@ impl Builder<'_> {
         p: &PluginDesc,
     ) -> Vec<PrimKind> {
         let before = prims.len();
-        prims.retain(|&k| {
+        let within = |&k: &PrimKind| {
             let (lo, hi) = geom.kind_bounds(k);
             crate::accel::box_in_range(lo, hi)
-        });
+        };
+        // Mostly every primitive is in range: checked on every thread, kept as it is.
+        if prims.len() >= PARALLEL_MIN && prims.par_iter().all(within) {
+            return prims;
+        }
+        prims.retain(within);
         if prims.len() < before {
             self.warnings.push(Warning::at(
                 &p.loc,
@@ -406,8 +421,11 @@ impl Builder<'_> {
     ) {
         let Some((light, media)) = area_light else {
             let surface = self.surface(surface);
-            for kind in prims {
-                geom.push(Prim { kind, surface });
+            let prim = |&kind: &PrimKind| Prim { kind, surface };
+            if prims.len() >= PARALLEL_MIN {
+                geom.extend(prims.par_iter().map(prim));
+            } else {
+                prims.iter().for_each(|k| geom.push(prim(k)));
             }
             return;
         };
