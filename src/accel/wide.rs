@@ -14,6 +14,7 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 
 /// Most primitives in a leaf: the CWBVH encoding's limit.
 const LEAF_MAX: usize = 3;
@@ -71,22 +72,47 @@ impl Set {
 
 /// A wide BVH over `count` primitives whose boxes `bounds` gives, in obvhs's layout:
 /// `primitive_indices` maps leaf order to the primitives' indices. `count` must not be zero.
+#[cfg(test)]
 pub fn build_wide(count: usize, bounds: impl Fn(usize) -> Aabb + Sync) -> CwBvh {
+    let mut scratch: Vec<Item> = Vec::with_capacity(count);
+    build_wide_in(count, bounds, scratch.spare_capacity_mut())
+}
+
+/// [`build_wide`] with the builder's records (32 bytes a primitive) in `scratch`, which must
+/// hold at least as many bytes, aligned to 16: the caller's buffer for what it writes after
+/// the build (on a million triangles, 8,000 fewer pages faulted in than a buffer each).
+pub fn build_wide_in<T>(
+    count: usize,
+    bounds: impl Fn(usize) -> Aabb + Sync,
+    scratch: &mut [MaybeUninit<T>],
+) -> CwBvh {
     assert!(count > 0, "a BVH over nothing");
-    let mut items: Vec<Item> = (0..count)
-        .into_par_iter()
-        .map(|i| {
-            let b = bounds(i);
-            Item {
-                lo: b.min.to_array(),
-                index: i as u32,
-                hi: b.max.to_array(),
-                _pad: 0.0,
-            }
-        })
-        .collect();
-    let root = set_of(&items, 0, items.len());
-    let tree = subtree(&mut items, root, 0);
+    assert!(std::mem::align_of::<T>() % std::mem::align_of::<Item>() == 0);
+    let bytes = std::mem::size_of_val(scratch);
+    assert!(
+        bytes >= count * std::mem::size_of::<Item>(),
+        "scratch too small"
+    );
+    // SAFETY: the memory is `scratch`'s, borrowed mutably for as long as the view, aligned
+    // for `Item` (checked above) and large enough for `count` of them; `MaybeUninit` makes no
+    // claim on its contents.
+    let slots: &mut [MaybeUninit<Item>] = unsafe {
+        std::slice::from_raw_parts_mut(scratch.as_mut_ptr().cast::<MaybeUninit<Item>>(), count)
+    };
+    slots.par_iter_mut().enumerate().for_each(|(i, slot)| {
+        let b = bounds(i);
+        slot.write(Item {
+            lo: b.min.to_array(),
+            index: i as u32,
+            hi: b.max.to_array(),
+            _pad: 0.0,
+        });
+    });
+    // SAFETY: every slot was written just above.
+    let items: &mut [Item] =
+        unsafe { &mut *(std::ptr::from_mut::<[MaybeUninit<Item>]>(slots) as *mut [Item]) };
+    let root = set_of(items, 0, items.len());
+    let tree = subtree(items, root, 0);
     CwBvh {
         nodes: tree.nodes,
         primitive_indices: tree.order,
@@ -354,8 +380,29 @@ impl Builder<'_> {
     /// exact SAH on one axis, where binning's fixed cost would outweigh the sweep.
     fn split_small(&mut self, set: Set, axis: usize) -> (Set, Set) {
         let items = &mut self.items[set.start..set.end];
-        items.sort_unstable_by(|a, b| a.centroid2()[axis].total_cmp(&b.centroid2()[axis]));
         let n = items.len();
+        // Sorted by key, stably (the standard sort of so few items is an insertion sort, stable
+        // too, so the order is the one sorting the items themselves gave): small keys move
+        // rather than 32-byte items, and each key is computed once.
+        let mut keyed = [(0.0f32, 0u8); SMALL];
+        for (k, (slot, it)) in keyed.iter_mut().zip(items.iter()).enumerate() {
+            *slot = (it.centroid2()[axis], k as u8);
+        }
+        let keyed = &mut keyed[..n];
+        for i in 1..n {
+            let x = keyed[i];
+            let mut j = i;
+            while j > 0 && x.0.total_cmp(&keyed[j - 1].0).is_lt() {
+                keyed[j] = keyed[j - 1];
+                j -= 1;
+            }
+            keyed[j] = x;
+        }
+        let mut sorted = [items[0]; SMALL];
+        for (dst, &(_, k)) in sorted.iter_mut().zip(keyed.iter()) {
+            *dst = items[k as usize];
+        }
+        items.copy_from_slice(&sorted[..n]);
         let mut right_area = [0.0f32; SMALL];
         let mut acc = Aabb::empty();
         for k in (1..n).rev() {
@@ -399,6 +446,16 @@ impl Builder<'_> {
 fn bin_items(items: &[Item], bin_of: impl Fn(&Item) -> usize) -> [(Aabb, u32); BINS] {
     // Two sets of bins, for alternate items, merged after: consecutive items (neighbours in a
     // mesh) mostly fall in one bin, and one set made each update wait for the last.
+    if items.len() < 64 {
+        // Few items: one set of bins, as the two sets' setting up would cost more.
+        let mut bins = [(Aabb::empty(), 0u32); BINS];
+        for it in items {
+            let bin = &mut bins[bin_of(it)];
+            bin.0 = bin.0.union(&it.aabb());
+            bin.1 += 1;
+        }
+        return bins;
+    }
     let mut twin = [[(Aabb::empty(), 0u32); BINS]; 2];
     for pair in items.chunks(2) {
         for (bins, it) in twin.iter_mut().zip(pair) {

@@ -48,7 +48,7 @@ impl TriangleMesh {
                 .uvs
                 .as_ref()
                 .map(|uvs| uvs.iter().map(|&uv| Vec2::from_array(uv)).collect()),
-            indices: mesh.indices.clone(),
+            indices: map_all(&mesh.indices, |&i| i),
             reverse_orientation,
             transform_swaps_handedness: to_world.swaps_handedness(),
         }
