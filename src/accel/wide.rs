@@ -180,12 +180,12 @@ fn subtree(items: &mut [Item], set: Set, depth: u32) -> Subtree {
     built.sort_by_key(|(k, _)| *k);
     // The children's roots sit together after the root; each child's other nodes follow.
     let first = nodes.len() - built.len();
-    let mut base = nodes.len() as u32;
+    let (mut base, mut prims) = (nodes.len(), order.len());
     let mut shifts = Vec::with_capacity(built.len());
     for (_, sub) in &built {
-        shifts.push((base, order.len() as u32));
-        order.extend_from_slice(&sub.order);
-        base += sub.nodes.len() as u32 - 1;
+        shifts.push((base as u32, prims as u32));
+        base += sub.nodes.len() - 1;
+        prims += sub.order.len();
     }
     // A node's children at local index c (>= 1) move to base + c - 1.
     let shift = |n: &CwBvhNode, (base, prims): (u32, u32)| CwBvhNode {
@@ -193,10 +193,36 @@ fn subtree(items: &mut [Item], set: Set, depth: u32) -> Subtree {
         primitive_base_idx: n.primitive_base_idx + prims,
         ..*n
     };
-    nodes.reserve(base as usize - nodes.len());
     for (k, (_, sub)) in built.iter().enumerate() {
         nodes[first + k] = shift(&sub.nodes[0], shifts[k]);
-        nodes.extend(sub.nodes[1..].iter().map(|n| shift(n, shifts[k])));
+    }
+    // The rest is copied on every thread, each child's part into its own room (at the root,
+    // megabytes copied and faulted in on one thread otherwise).
+    let (old_nodes, old_order) = (nodes.len(), order.len());
+    nodes.reserve_exact(base - old_nodes);
+    order.reserve_exact(prims - old_order);
+    let mut node_room = &mut nodes.spare_capacity_mut()[..base - old_nodes];
+    let mut order_room = &mut order.spare_capacity_mut()[..prims - old_order];
+    let mut parts = Vec::with_capacity(built.len());
+    for ((_, sub), &s) in built.iter().zip(&shifts) {
+        let (n, rest) = std::mem::take(&mut node_room).split_at_mut(sub.nodes.len() - 1);
+        node_room = rest;
+        let (o, rest) = std::mem::take(&mut order_room).split_at_mut(sub.order.len());
+        order_room = rest;
+        parts.push((n, o, sub, s));
+    }
+    parts.into_par_iter().for_each(|(n, o, sub, s)| {
+        for (dst, node) in n.iter_mut().zip(&sub.nodes[1..]) {
+            dst.write(shift(node, s));
+        }
+        for (dst, &i) in o.iter_mut().zip(&sub.order) {
+            dst.write(i);
+        }
+    });
+    // SAFETY: the parts cover the new room exactly, and each of their slots was written above.
+    unsafe {
+        nodes.set_len(base);
+        order.set_len(prims);
     }
     Subtree { nodes, order }
 }
