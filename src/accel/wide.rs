@@ -122,9 +122,6 @@ pub fn build_wide_in<T>(
     }
 }
 
-/// Sets of at least this many primitives are binned on every thread.
-const PARALLEL_BINS: usize = if cfg!(test) { 64 } else { 1 << 16 };
-
 /// Sets of more primitives than this have their inner children built in parallel (few in tests,
 /// so that small test scenes take the parallel path too).
 const PARALLEL_MIN: usize = if cfg!(test) { 64 } else { 1 << 15 };
@@ -336,17 +333,7 @@ impl Builder<'_> {
             // last bin through the `min`.
             (((c - min) * scale) as usize).min(BINS - 1)
         };
-        let items = &self.items[set.start..set.end];
-        // The top levels' sets are binned on every thread, in chunks of a fixed size: a bin's
-        // box is a min and max and its count a sum, so any grouping gives the same bins.
-        let bins = if items.len() >= PARALLEL_BINS {
-            items
-                .par_chunks(PARALLEL_BINS / 4)
-                .map(|chunk| bin_items(chunk, bin_of))
-                .reduce(|| [(Aabb::empty(), 0u32); BINS], merge_bins)
-        } else {
-            bin_items(items, bin_of)
-        };
+        let bins = bin_items(&self.items[set.start..set.end], bin_of);
         // Cost of each plane (after bin k): area times count on both sides.
         let mut right = [(Aabb::empty(), 0u32); BINS];
         let mut acc = (Aabb::empty(), 0u32);
