@@ -302,8 +302,9 @@ pub fn read_file(path: &Path, kind: FileKind) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let (file, len) = open_file(path, kind)?;
     let limit = kind.max_bytes();
-    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
-    file.take(limit + 1).read_to_end(&mut bytes)?;
+    let mut bytes = read_halves(&file, len)?;
+    file.take(limit + 1 - bytes.len() as u64)
+        .read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
         return Err(too_long(bytes.len() as u64, kind));
     }
@@ -322,6 +323,40 @@ pub fn read_file(path: &Path, kind: FileKind) -> std::io::Result<Vec<u8>> {
         )));
     }
     Ok(text)
+}
+
+/// Files of at least this many bytes are read in two halves at once.
+const HALVES_MIN: u64 = 1 << 22;
+
+/// The first `len` bytes of `file` (its length when opened, at most its kind's limit), the
+/// file's position left at their end. A large file is read in two halves at once, each on its
+/// own thread: the copy into fresh pages was most of reading a 24 MB mesh
+/// (docs/BENCHMARKS.md). A file that has shrunk meanwhile gives what it still holds.
+fn read_halves(file: &std::fs::File, len: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::{Read, Seek};
+    let n = usize::try_from(len).unwrap_or(0);
+    #[cfg(unix)]
+    if len >= HALVES_MIN {
+        use std::os::unix::fs::FileExt;
+        // Zeroed by the allocator's fresh mapping, so that each thread faults its own half in.
+        let mut bytes = vec![0u8; n];
+        let (a, b) = bytes.split_at_mut(n / 2);
+        let half = a.len() as u64;
+        let (ra, rb) = std::thread::scope(|s| {
+            let second = s.spawn(|| file.read_exact_at(b, half));
+            (file.read_exact_at(a, 0), second.join())
+        });
+        if let (Ok(()), Ok(Ok(()))) = (ra, rb) {
+            let mut f = file;
+            f.seek(std::io::SeekFrom::Start(len))?;
+            return Ok(bytes);
+        }
+    }
+    let mut bytes = Vec::with_capacity(n);
+    let mut f = file;
+    f.seek(std::io::SeekFrom::Start(0))?;
+    f.take(len).read_to_end(&mut bytes)?;
+    Ok(bytes)
 }
 
 /// Whether `path` names a gzip-compressed file (`.gz`, any case).
@@ -388,6 +423,23 @@ mod tests {
             "{e}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_large_file_read_in_two_halves_is_the_file() {
+        let dir = temp_dir("halves");
+        for n in [HALVES_MIN as usize, HALVES_MIN as usize + 7] {
+            let path = dir.join(format!("mesh-{n}.ply"));
+            let bytes: Vec<u8> = (0..n as u64)
+                .map(|i| (i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 56) as u8)
+                .collect();
+            std::fs::write(&path, &bytes).unwrap();
+            assert!(
+                read_file(&path, FileKind::Ply).unwrap() == bytes,
+                "{n} bytes"
+            );
+        }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
