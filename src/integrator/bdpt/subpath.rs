@@ -45,6 +45,35 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
     max_depth: usize,
     path: &mut Subpath,
 ) -> usize {
+    let pdf_dir = |ray: &Ray| scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
+    camera_subpath(scene, (ray, diff), sampler, max_depth, path, pdf_dir)
+}
+
+/// [`generate_camera_subpath_from`] for a ray the camera generated through a point of its
+/// film (mlt's): the ray's density from its cosine alone, without mapping it back onto the
+/// film (`Camera::pdf_we_dir_on_film`).
+pub fn generate_camera_subpath_on_film<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    ray: Ray,
+    diff: Option<&RayDifferentials>,
+    sampler: &mut S,
+    max_depth: usize,
+    path: &mut Subpath,
+) -> usize {
+    let pdf_dir = |ray: &Ray| scene.camera.pdf_we_dir_on_film(ray.o, ray.d, ray.time);
+    camera_subpath(scene, (ray, diff), sampler, max_depth, path, pdf_dir)
+}
+
+/// The camera subpath from `ray`, the density of its direction from `pdf_dir`.
+#[inline(always)]
+fn camera_subpath<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    (ray, diff): (Ray, Option<&RayDifferentials>),
+    sampler: &mut S,
+    max_depth: usize,
+    path: &mut Subpath,
+    pdf_dir: impl Fn(&Ray) -> f32,
+) -> usize {
     path.clear();
     if max_depth == 0 {
         return 0;
@@ -55,10 +84,9 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
         // The camera alone (mlt's t = 1): the ray's density would go unused.
         return 1;
     }
-    let pdf_dir = scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
     let walk = Walk {
         beta: Spectrum::ONE,
-        pdf: pdf_dir,
+        pdf: pdf_dir(&ray),
         max_depth: max_depth - 1,
         mode: Mode::Radiance,
         medium: scene.camera_medium,

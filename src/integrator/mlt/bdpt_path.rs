@@ -7,7 +7,7 @@ use super::contribution::{raster_position, Contribution, PathContribution};
 use super::sampler::{MltSampler, CAMERA_STREAM, CONNECTION_STREAM, LIGHT_STREAM};
 use crate::camera::CameraSample;
 use crate::integrator::bdpt::{
-    connect, generate_camera_subpath_from, generate_light_subpath, LightChoice, Subpath,
+    connect, generate_camera_subpath_on_film, generate_light_subpath, LightChoice, Subpath,
 };
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -77,13 +77,14 @@ impl PathContribution for BdptContribution {
             let (ray, made) = if scene.uses_differentials {
                 let (ray, diff) = scene.camera.generate_ray_differential(&sample);
                 let diff = diff.scaled(&ray, self.differential_scale);
-                let n = generate_camera_subpath_from(scene, ray, Some(&diff), sampler, t, camera);
+                let n =
+                    generate_camera_subpath_on_film(scene, ray, Some(&diff), sampler, t, camera);
                 (ray, n)
             } else {
                 let ray = scene.camera.generate_ray(&sample);
                 (
                     ray,
-                    generate_camera_subpath_from(scene, ray, None, sampler, t, camera),
+                    generate_camera_subpath_on_film(scene, ray, None, sampler, t, camera),
                 )
             };
             c.rays = made as u32;

@@ -21,6 +21,9 @@ use std::time::Instant;
 /// the time limit is looked at (about a second's work on two cores for a simple scene).
 const MUTATIONS_PER_ROUND: u64 = 1 << 18;
 
+/// A splat: a raster position and the radiance added there.
+type Splat = (Vec2, Spectrum);
+
 /// One chain's round: what it counted, the mutations it made (its splats are in the chain).
 type Round = (Tally, u64);
 
@@ -128,7 +131,9 @@ impl Bootstrap {
     }
 }
 
-/// One Markov chain: its state and what it has left to do.
+/// One Markov chain: its state and what it has left to do. Aligned to 128 bytes (two cache
+/// lines, what the prefetcher pairs) so that chains run on different threads share none.
+#[repr(align(128))]
 struct Chain {
     sampler: MltSampler,
     /// Decides acceptance (and chose the first state).
@@ -141,7 +146,7 @@ struct Chain {
     /// Mutations left.
     left: u64,
     /// The splats of the round under way (kept from round to round: no allocation per round).
-    splats: Vec<(Vec2, Spectrum)>,
+    splats: Vec<Splat>,
 }
 
 impl Chain {
@@ -284,23 +289,32 @@ pub fn render_with<F: PathContribution>(
     }
     let per_round = (MUTATIONS_PER_ROUND / n_chains).max(1);
     let mut made = 0u64;
+    // The last round's splats, per chain: they go to the film (in chain order, one thread)
+    // while the chains make the next round's, instead of the threads waiting on the merge.
+    let mut pending: Vec<Vec<Splat>> = chains.iter().map(|_| Vec::new()).collect();
     let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     while chains.iter().any(|c| c.left > 0) {
-        let rounds: Vec<Round> = chains
-            .par_iter_mut()
-            .map(|c| {
-                let mut t = Tally::default();
-                let n = c.run(&setup, per_round, &mut t);
-                (t, n)
-            })
-            .collect();
-        for (c, (t, n)) in chains.iter_mut().zip(rounds) {
-            film.add_splats(&c.splats);
-            c.splats.clear();
+        let (rounds, ()) = rayon::join(
+            || {
+                chains
+                    .par_iter_mut()
+                    .map(|c| {
+                        let mut t = Tally::default();
+                        let n = c.run(&setup, per_round, &mut t);
+                        (t, n)
+                    })
+                    .collect::<Vec<Round>>()
+            },
+            || merge(film, &mut pending),
+        );
+        let on_film = made;
+        for ((c, p), (t, n)) in chains.iter_mut().zip(&mut pending).zip(rounds) {
+            std::mem::swap(&mut c.splats, p);
             tally.add(t);
             made += n;
         }
-        film.unfiltered_mut().set_scale(scale(b, area, made));
+        // The film holds the rounds before this one.
+        film.unfiltered_mut().set_scale(scale(b, area, on_film));
         if let Some(p) = progress {
             p.set_position(made);
         }
@@ -316,11 +330,20 @@ pub fn render_with<F: PathContribution>(
             break;
         }
     }
+    merge(film, &mut pending);
     film.unfiltered_mut().set_scale(scale(b, area, made));
     counts.samples = made;
     counts.rays = tally.rays;
     counts.dropped = tally.dropped;
     counts
+}
+
+/// Adds `pending`'s splats to `film`, chain by chain, and empties them.
+fn merge(film: &mut Film, pending: &mut [Vec<Splat>]) {
+    for p in pending {
+        film.add_splats(p);
+        p.clear();
+    }
 }
 
 /// The splats' scale: `b` over the mutations per pixel made (pbrt-v3's `b /
