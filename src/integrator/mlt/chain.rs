@@ -71,32 +71,36 @@ impl Tally {
 }
 
 /// The bootstrap: `bootstrapsamples` independent paths of every depth, their luminances
-/// (the weights the chains start from, indexed `i * (maxdepth + 1) + depth`).
+/// (the weights the chains start from, indexed `i * (maxdepth + 1) + depth`). Written in
+/// place, chunk by chunk, and the tallies summed: a vector of (weight, tally) pairs would be
+/// six times the weights' memory, most of mlt's peak.
 fn bootstrap<F: PathContribution>(setup: &Setup<F>, tally: &mut Tally) -> Vec<f32> {
     let depths = setup.f.max_depth() + 1;
     let n = setup.settings.bootstrap_samples as usize * depths as usize;
-    let results: Vec<(f32, Tally)> = (0..n)
-        .into_par_iter()
-        .with_min_len(64)
+    let mut weights = vec![0.0f32; n];
+    const CHUNK: usize = 64;
+    let counted = weights
+        .par_chunks_mut(CHUNK)
+        .enumerate()
         .map_init(
             || setup.sampler(0),
-            |sampler, index| {
-                let index = index as u64;
+            |sampler, (c, chunk)| {
                 let mut t = Tally::default();
-                let depth = (index % u64::from(depths)) as u32;
-                sampler.reset(setup.seed, index);
-                let c = setup.eval(sampler, depth, &mut t);
-                (spectrum_luminance(c.l), t)
+                for (k, w) in chunk.iter_mut().enumerate() {
+                    let index = (c * CHUNK + k) as u64;
+                    let depth = (index % u64::from(depths)) as u32;
+                    sampler.reset(setup.seed, index);
+                    *w = spectrum_luminance(setup.eval(sampler, depth, &mut t).l);
+                }
+                t
             },
         )
-        .collect();
-    results
-        .into_iter()
-        .map(|(w, t)| {
-            tally.add(t);
-            w
-        })
-        .collect()
+        .reduce(Tally::default, |mut a, b| {
+            a.add(b);
+            a
+        });
+    tally.add(counted);
+    weights
 }
 
 /// The running sums of the bootstrap weights, for choosing chains' first states.
@@ -264,6 +268,7 @@ pub fn render_with<F: PathContribution>(
     } else {
         boot.total() / weights.len() as f64 * f64::from(f.max_depth() + 1)
     };
+    drop(weights);
     let area = space.pixels();
     let total = u64::from(settings.mutations_per_pixel) * area;
     let n_chains = u64::from(settings.chains);
