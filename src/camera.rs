@@ -383,6 +383,11 @@ impl Camera {
         )
     }
 
+    /// The time of `s`'s ray: [`Camera::generate_ray`]'s, without the ray.
+    pub fn sample_time(&self, s: &CameraSample) -> f32 {
+        self.time(s)
+    }
+
     /// The sample's time within the shutter.
     fn time(&self, s: &CameraSample) -> f32 {
         self.shutter_open + s.time * (self.shutter_close - self.shutter_open)
