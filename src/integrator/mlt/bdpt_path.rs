@@ -82,15 +82,18 @@ impl PathContribution for BdptContribution {
                 camera.clear();
                 (Vec3::ZERO, scene.camera.sample_time(&sample))
             } else {
+                // The s = 0 strategy reads its last vertex's emission, not its scattering.
+                let depth = (t, s != 0);
                 let (ray, made) = if scene.uses_differentials {
                     let (ray, diff) = scene.camera.generate_ray_differential(&sample);
                     let diff = diff.scaled(&ray, self.differential_scale);
-                    let d = Some(&diff);
-                    let n = generate_camera_subpath_on_film(scene, ray, d, sampler, t, camera);
+                    let at = (ray, Some(&diff));
+                    let n = generate_camera_subpath_on_film(scene, at, sampler, depth, camera);
                     (ray, n)
                 } else {
                     let ray = scene.camera.generate_ray(&sample);
-                    let n = generate_camera_subpath_on_film(scene, ray, None, sampler, t, camera);
+                    let n =
+                        generate_camera_subpath_on_film(scene, (ray, None), sampler, depth, camera);
                     (ray, n)
                 };
                 c.rays = made as u32;
