@@ -69,6 +69,9 @@ pub struct Camera {
     /// The unit viewing direction in world space when the camera does not move (importance's
     /// cosine, asked for at every connection).
     forward: Option<Vec3>,
+    /// The full film's area on the plane at distance 1 (pbrt-v3's `A`), for importance:
+    /// computed once, where every connection to the camera asked for it.
+    film_area: f32,
     /// Thin-lens radius; 0 for a pinhole.
     pub lens_radius: f32,
     /// Distance to the plane in focus.
@@ -212,6 +215,7 @@ impl Camera {
             world_from_camera,
             camera_from_world,
             forward,
+            film_area: importance::film_area(&raster_to_camera, (xres, yres)),
             lens_radius,
             focal_distance,
             shutter_open,
@@ -377,6 +381,11 @@ impl Camera {
             m.transform_vector3(Vec3::Z).normalize(),
             time,
         )
+    }
+
+    /// The time of `s`'s ray: [`Camera::generate_ray`]'s, without the ray.
+    pub fn sample_time(&self, s: &CameraSample) -> f32 {
+        self.time(s)
     }
 
     /// The sample's time within the shutter.

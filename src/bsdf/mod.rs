@@ -115,6 +115,12 @@ impl Bsdf {
         self.len = 0;
     }
 
+    /// Removes every lobe (the BSDF is then black: a vertex whose scattering nothing reads).
+    #[inline]
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
     /// Adds a lobe with weight 1; returns false (and adds nothing) when full.
     #[inline]
     pub fn add(&mut self, bxdf: Bxdf) -> bool {

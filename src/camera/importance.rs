@@ -25,16 +25,21 @@ pub struct ImportanceSample {
     pub raster: Vec2,
 }
 
+/// The area of a film of `resolution` on the plane at distance 1 (pbrt-v3's `A`).
+pub(super) fn film_area(raster_to_camera: &glam::Mat4, resolution: (f32, f32)) -> f32 {
+    let at = |x: f32, y: f32| {
+        let p = *raster_to_camera * Vec4::new(x, y, 0.0, 1.0);
+        let p = p.truncate() / p.w;
+        p / p.z
+    };
+    let (a, b) = (at(0.0, 0.0), at(resolution.0, resolution.1));
+    ((b.x - a.x) * (b.y - a.y)).abs()
+}
+
 impl Camera {
     /// The area of the full film on the plane at distance 1 (pbrt-v3's `A`).
     fn film_area(&self) -> f32 {
-        let at = |x: f32, y: f32| {
-            let p = self.raster_to_camera * Vec4::new(x, y, 0.0, 1.0);
-            let p = p.truncate() / p.w;
-            p / p.z
-        };
-        let (a, b) = (at(0.0, 0.0), at(self.resolution.0, self.resolution.1));
-        ((b.x - a.x) * (b.y - a.y)).abs()
+        self.film_area
     }
 
     /// The lens's area (1 for a pinhole).
@@ -98,6 +103,23 @@ impl Camera {
             ),
             None => (0.0, 0.0),
         }
+    }
+
+    /// [`Camera::pdf_we`]'s direction density for unit `d` of a ray this camera generated
+    /// through its film at `time` (so known to land on it): the cosine alone, without the
+    /// ray mapped back to the film, when the camera does not move.
+    pub fn pdf_we_dir_on_film(&self, o: Vec3, d: Vec3, time: f32) -> f32 {
+        let Some(forward) = self.forward else {
+            return self.pdf_we(o, d, time).1;
+        };
+        if self.projection != Projection::Perspective {
+            return 0.0;
+        }
+        let cos = d.dot(forward);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        1.0 / (self.film_area() * cos * cos * cos)
     }
 
     /// pbrt-v3's `Sample_Wi`: a lens point seen from `p` at `time`, chosen with `u`; `None`

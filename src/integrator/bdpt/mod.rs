@@ -26,7 +26,10 @@ mod vertex;
 
 pub use connect::{connect, Connection};
 pub use path_slots::Subpath;
-pub use subpath::{generate_camera_subpath, generate_camera_subpath_from, generate_light_subpath};
+pub use subpath::{
+    generate_camera_subpath, generate_camera_subpath_from, generate_camera_subpath_on_film,
+    generate_light_subpath,
+};
 pub use vertex::{Mode, Vertex, VertexKind};
 
 use super::MAX_PASS_THROUGH;

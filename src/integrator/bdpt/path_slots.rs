@@ -87,11 +87,11 @@ impl Subpath {
     }
 
     /// Appends the surface vertex at the (shaded) hit [`Subpath::next_interaction`] holds,
-    /// with `material`'s BSDF refilled in place, reached from the last vertex with solid-angle
-    /// density `pdf`.
+    /// with `material`'s BSDF refilled in place (none without one), reached from the last
+    /// vertex with solid-angle density `pdf`.
     pub fn push_surface(
         &mut self,
-        material: &Material,
+        material: Option<&Material>,
         at: (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,

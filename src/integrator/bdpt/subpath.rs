@@ -45,6 +45,49 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
     max_depth: usize,
     path: &mut Subpath,
 ) -> usize {
+    let pdf_dir = |ray: &Ray| scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
+    camera_subpath(
+        scene,
+        (ray, diff),
+        sampler,
+        (max_depth, true),
+        path,
+        pdf_dir,
+    )
+}
+
+/// [`generate_camera_subpath_from`] for a ray the camera generated through a point of its
+/// film (mlt's): the ray's density from its cosine alone, without mapping it back onto the
+/// film (`Camera::pdf_we_dir_on_film`). Without `last_scatters` a surface vertex at the
+/// walk's last bounce gets no BSDF (mlt's s = 0 strategy reads only its emission).
+pub fn generate_camera_subpath_on_film<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    (ray, diff): (Ray, Option<&RayDifferentials>),
+    sampler: &mut S,
+    (max_depth, last_scatters): (usize, bool),
+    path: &mut Subpath,
+) -> usize {
+    let pdf_dir = |ray: &Ray| scene.camera.pdf_we_dir_on_film(ray.o, ray.d, ray.time);
+    camera_subpath(
+        scene,
+        (ray, diff),
+        sampler,
+        (max_depth, last_scatters),
+        path,
+        pdf_dir,
+    )
+}
+
+/// The camera subpath from `ray`, the density of its direction from `pdf_dir`.
+#[inline(always)]
+fn camera_subpath<S: SampleSource + ?Sized>(
+    scene: &Scene,
+    (ray, diff): (Ray, Option<&RayDifferentials>),
+    sampler: &mut S,
+    (max_depth, last_scatters): (usize, bool),
+    path: &mut Subpath,
+    pdf_dir: impl Fn(&Ray) -> f32,
+) -> usize {
     path.clear();
     if max_depth == 0 {
         return 0;
@@ -55,13 +98,13 @@ pub fn generate_camera_subpath_from<S: SampleSource + ?Sized>(
         // The camera alone (mlt's t = 1): the ray's density would go unused.
         return 1;
     }
-    let pdf_dir = scene.camera.pdf_we(ray.o, ray.d, ray.time).1;
     let walk = Walk {
         beta: Spectrum::ONE,
-        pdf: pdf_dir,
+        pdf: pdf_dir(&ray),
         max_depth: max_depth - 1,
         mode: Mode::Radiance,
         medium: scene.camera_medium,
+        last_scatters,
     };
     random_walk(scene, ray, diff, sampler, walk, path) + 1
 }
@@ -110,6 +153,7 @@ pub fn generate_light_subpath<S: SampleSource + ?Sized>(
         max_depth: max_depth - 1,
         mode: Mode::Importance,
         medium: path[0].medium_toward(scene, e.d),
+        last_scatters: true,
     };
     let n_walk = random_walk(scene, Ray::new(o, e.d, time), None, sampler, walk, path);
     // Infinite lights: the first surface's density is the disk's, and the light's that of
@@ -148,6 +192,8 @@ struct Walk {
     mode: Mode,
     /// The medium the first ray travels in.
     medium: Option<u32>,
+    /// Whether a surface vertex at the last bounce gets its BSDF (else nothing reads it).
+    last_scatters: bool,
 }
 
 /// pbrt-v3's `RandomWalk` (without Russian roulette, as pbrt-v3's bdpt): adds up to
@@ -171,6 +217,7 @@ fn random_walk<S: SampleSource + ?Sized>(
         max_depth,
         mode,
         mut medium,
+        last_scatters,
     } = walk;
     let mut pdf_fwd = pdf;
     let mut bounces = 0;
@@ -237,7 +284,8 @@ fn random_walk<S: SampleSource + ?Sized>(
         let material = &scene.materials[material as usize];
         material.shade(si);
         let at = (surface.area_light, media);
-        path.push_surface(material, at, beta, pdf_fwd);
+        let scatters = last_scatters || bounces + 1 < max_depth;
+        path.push_surface(scatters.then_some(material), at, beta, pdf_fwd);
         bounces += 1;
         if bounces >= max_depth {
             break;

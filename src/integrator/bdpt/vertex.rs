@@ -206,11 +206,12 @@ impl Vertex {
     }
 
     /// Makes this vertex a surface vertex at the (shaded) interaction it holds (see
-    /// [`super::Subpath::next_interaction`]) with `material`'s BSDF refilled in place, reached
-    /// from `prev` with solid-angle density `pdf`.
+    /// [`super::Subpath::next_interaction`]) with `material`'s BSDF refilled in place (no
+    /// lobes without one: nothing will read its scattering), reached from `prev` with
+    /// solid-angle density `pdf`.
     pub fn make_surface(
         &mut self,
-        material: &Material,
+        material: Option<&Material>,
         (light, media): (Option<u32>, MediumInterface),
         beta: Spectrum,
         pdf: f32,
@@ -220,7 +221,10 @@ impl Vertex {
             .surface
             .as_mut()
             .expect("Subpath::next_interaction gives the slot an interaction");
-        material.bsdf_into(&point.si, &mut point.bsdf);
+        match material {
+            Some(m) => m.bsdf_into(&point.si, &mut point.bsdf),
+            None => point.bsdf.clear(),
+        }
         let si = &point.si;
         let (p, ng) = (si.p, si.n);
         (self.p, self.ng, self.ns, self.time) = (p, ng, si.shading_n, si.time);

@@ -6,8 +6,9 @@
 use super::contribution::{raster_position, Contribution, PathContribution};
 use super::sampler::{MltSampler, CAMERA_STREAM, CONNECTION_STREAM, LIGHT_STREAM};
 use crate::camera::CameraSample;
+use crate::geometry::Vec3;
 use crate::integrator::bdpt::{
-    connect, generate_camera_subpath_from, generate_light_subpath, LightChoice, Subpath,
+    connect, generate_camera_subpath_on_film, generate_light_subpath, LightChoice, Subpath,
 };
 use crate::lightdistrib::LightStrategy;
 use crate::scene::Scene;
@@ -74,28 +75,47 @@ impl PathContribution for BdptContribution {
         };
         PATHS.with(|paths| {
             let (camera, light) = &mut *paths.borrow_mut();
-            let (ray, made) = if scene.uses_differentials {
-                let (ray, diff) = scene.camera.generate_ray_differential(&sample);
-                let diff = diff.scaled(&ray, self.differential_scale);
-                let n = generate_camera_subpath_from(scene, ray, Some(&diff), sampler, t, camera);
-                (ray, n)
+            let (origin, time) = if t == 1 && self.light_strategy != LightStrategy::Spatial {
+                // Light tracing (t = 1) connects to a lens point of its own: the camera ray
+                // would go unused but for its time (and its origin, for a light choice that
+                // depends on where it is looked up: only `spatial`'s does).
+                camera.clear();
+                (Vec3::ZERO, scene.camera.sample_time(&sample))
             } else {
-                let ray = scene.camera.generate_ray(&sample);
-                (
-                    ray,
-                    generate_camera_subpath_from(scene, ray, None, sampler, t, camera),
-                )
+                // The s = 0 strategy reads its last vertex's emission, not its scattering.
+                let depth = (t, s != 0);
+                let (ray, made) = if scene.uses_differentials {
+                    let (ray, diff) = scene.camera.generate_ray_differential(&sample);
+                    let diff = diff.scaled(&ray, self.differential_scale);
+                    let at = (ray, Some(&diff));
+                    let n = generate_camera_subpath_on_film(scene, at, sampler, depth, camera);
+                    (ray, n)
+                } else {
+                    let ray = scene.camera.generate_ray(&sample);
+                    let n =
+                        generate_camera_subpath_on_film(scene, (ray, None), sampler, depth, camera);
+                    (ray, n)
+                };
+                c.rays = made as u32;
+                if made != t {
+                    return c;
+                }
+                (ray.o, ray.time)
             };
-            c.rays = made as u32;
-            if made != t {
-                return c;
-            }
             sampler.start_stream(LIGHT_STREAM);
-            let choice = LightChoice::new(scene, self.light_strategy, ray.o);
-            let made = generate_light_subpath(scene, sampler, s, ray.time, &choice, light);
-            c.rays += made as u32;
-            if made != s {
-                return c;
+            let choice = LightChoice::new(scene, self.light_strategy, origin);
+            // The s = 1 strategy samples its light vertex itself (`connect`), and its MIS
+            // weight reads that vertex: a light subpath's would go unused. pbrt-v3 makes it
+            // and returns zero where its emission sample fails, which loses that share of
+            // s = 1's light (bdpt runs s = 1 regardless, docs/light-transport.md).
+            if s > 1 {
+                let made = generate_light_subpath(scene, sampler, s, time, &choice, light);
+                c.rays += made as u32;
+                if made != s {
+                    return c;
+                }
+            } else {
+                light.clear();
             }
             sampler.start_stream(CONNECTION_STREAM);
             let k = connect(scene, light, camera, s, t, &choice, sampler);

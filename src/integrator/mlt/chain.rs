@@ -17,9 +17,14 @@ use acr_plugins::{Film, RenderingSpace};
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// Mutations of all chains together per round: between rounds the splats go to the film and
-/// the time limit is looked at (about a second's work on two cores for a simple scene).
-const MUTATIONS_PER_ROUND: u64 = 1 << 18;
+/// Mutations of all chains together per round: between rounds the time limit is looked at,
+/// and a round's splats go to the film while the chains make the next round's (about a tenth
+/// of a second's work on two cores for a simple scene; the two rounds' splat buffers, about
+/// 10 bytes a mutation, bound mlt's memory).
+const MUTATIONS_PER_ROUND: u64 = 1 << 17;
+
+/// A splat: a raster position and the radiance added there.
+type Splat = (Vec2, Spectrum);
 
 /// One chain's round: what it counted, the mutations it made (its splats are in the chain).
 type Round = (Tally, u64);
@@ -68,32 +73,36 @@ impl Tally {
 }
 
 /// The bootstrap: `bootstrapsamples` independent paths of every depth, their luminances
-/// (the weights the chains start from, indexed `i * (maxdepth + 1) + depth`).
+/// (the weights the chains start from, indexed `i * (maxdepth + 1) + depth`). Written in
+/// place, chunk by chunk, and the tallies summed: a vector of (weight, tally) pairs would be
+/// six times the weights' memory, most of mlt's peak.
 fn bootstrap<F: PathContribution>(setup: &Setup<F>, tally: &mut Tally) -> Vec<f32> {
     let depths = setup.f.max_depth() + 1;
     let n = setup.settings.bootstrap_samples as usize * depths as usize;
-    let results: Vec<(f32, Tally)> = (0..n)
-        .into_par_iter()
-        .with_min_len(64)
+    let mut weights = vec![0.0f32; n];
+    const CHUNK: usize = 64;
+    let counted = weights
+        .par_chunks_mut(CHUNK)
+        .enumerate()
         .map_init(
             || setup.sampler(0),
-            |sampler, index| {
-                let index = index as u64;
+            |sampler, (c, chunk)| {
                 let mut t = Tally::default();
-                let depth = (index % u64::from(depths)) as u32;
-                sampler.reset(setup.seed, index);
-                let c = setup.eval(sampler, depth, &mut t);
-                (spectrum_luminance(c.l), t)
+                for (k, w) in chunk.iter_mut().enumerate() {
+                    let index = (c * CHUNK + k) as u64;
+                    let depth = (index % u64::from(depths)) as u32;
+                    sampler.reset(setup.seed, index);
+                    *w = spectrum_luminance(setup.eval(sampler, depth, &mut t).l);
+                }
+                t
             },
         )
-        .collect();
-    results
-        .into_iter()
-        .map(|(w, t)| {
-            tally.add(t);
-            w
-        })
-        .collect()
+        .reduce(Tally::default, |mut a, b| {
+            a.add(b);
+            a
+        });
+    tally.add(counted);
+    weights
 }
 
 /// The running sums of the bootstrap weights, for choosing chains' first states.
@@ -128,7 +137,9 @@ impl Bootstrap {
     }
 }
 
-/// One Markov chain: its state and what it has left to do.
+/// One Markov chain: its state and what it has left to do. Aligned to 128 bytes (two cache
+/// lines, what the prefetcher pairs) so that chains run on different threads share none.
+#[repr(align(128))]
 struct Chain {
     sampler: MltSampler,
     /// Decides acceptance (and chose the first state).
@@ -141,7 +152,7 @@ struct Chain {
     /// Mutations left.
     left: u64,
     /// The splats of the round under way (kept from round to round: no allocation per round).
-    splats: Vec<(Vec2, Spectrum)>,
+    splats: Vec<Splat>,
 }
 
 impl Chain {
@@ -173,10 +184,14 @@ impl Chain {
 
     /// Makes up to `n` mutations, pushing their splats to `self.splats` (pbrt-v3's: the
     /// proposal weighted by the acceptance, the current state by its complement, each over its
-    /// luminance).
+    /// luminance). The current state's weights are summed while it stays and splatted once
+    /// when it changes or the round ends: the same sum as pbrt-v3's splat per mutation, in
+    /// fewer splats.
     fn run<F: PathContribution>(&mut self, setup: &Setup<F>, n: u64, tally: &mut Tally) -> u64 {
         let splats = &mut self.splats;
         let n = n.min(self.left);
+        // The current state's summed weight not yet splatted.
+        let mut held = 0.0f32;
         for _ in 0..n {
             self.sampler.start_iteration();
             let proposed = setup.eval(&mut self.sampler, self.depth, tally);
@@ -190,16 +205,22 @@ impl Chain {
                 splats.push((proposed.raster, proposed.l * (accept / proposed_y)));
             }
             if accept < 1.0 && self.current_y > 0.0 {
-                let w = (1.0 - accept) / self.current_y;
-                splats.push((self.current.raster, self.current.l * w));
+                held += (1.0 - accept) / self.current_y;
             }
             if self.rng.next_f32() < accept {
+                if held > 0.0 {
+                    splats.push((self.current.raster, self.current.l * held));
+                    held = 0.0;
+                }
                 self.current = proposed;
                 self.current_y = proposed_y;
                 self.sampler.accept();
             } else {
                 self.sampler.reject();
             }
+        }
+        if held > 0.0 {
+            splats.push((self.current.raster, self.current.l * held));
         }
         self.left -= n;
         n
@@ -259,6 +280,7 @@ pub fn render_with<F: PathContribution>(
     } else {
         boot.total() / weights.len() as f64 * f64::from(f.max_depth() + 1)
     };
+    drop(weights);
     let area = space.pixels();
     let total = u64::from(settings.mutations_per_pixel) * area;
     let n_chains = u64::from(settings.chains);
@@ -284,23 +306,32 @@ pub fn render_with<F: PathContribution>(
     }
     let per_round = (MUTATIONS_PER_ROUND / n_chains).max(1);
     let mut made = 0u64;
+    // The last round's splats, per chain: they go to the film (in chain order, one thread)
+    // while the chains make the next round's, instead of the threads waiting on the merge.
+    let mut pending: Vec<Vec<Splat>> = chains.iter().map(|_| Vec::new()).collect();
     let mut last_look = vec![Instant::now(); stop.checkpoints.len()];
     while chains.iter().any(|c| c.left > 0) {
-        let rounds: Vec<Round> = chains
-            .par_iter_mut()
-            .map(|c| {
-                let mut t = Tally::default();
-                let n = c.run(&setup, per_round, &mut t);
-                (t, n)
-            })
-            .collect();
-        for (c, (t, n)) in chains.iter_mut().zip(rounds) {
-            film.add_splats(&c.splats);
-            c.splats.clear();
+        let (rounds, ()) = rayon::join(
+            || {
+                chains
+                    .par_iter_mut()
+                    .map(|c| {
+                        let mut t = Tally::default();
+                        let n = c.run(&setup, per_round, &mut t);
+                        (t, n)
+                    })
+                    .collect::<Vec<Round>>()
+            },
+            || merge(film, &mut pending),
+        );
+        let on_film = made;
+        for ((c, p), (t, n)) in chains.iter_mut().zip(&mut pending).zip(rounds) {
+            std::mem::swap(&mut c.splats, p);
             tally.add(t);
             made += n;
         }
-        film.unfiltered_mut().set_scale(scale(b, area, made));
+        // The film holds the rounds before this one.
+        film.unfiltered_mut().set_scale(scale(b, area, on_film));
         if let Some(p) = progress {
             p.set_position(made);
         }
@@ -316,11 +347,20 @@ pub fn render_with<F: PathContribution>(
             break;
         }
     }
+    merge(film, &mut pending);
     film.unfiltered_mut().set_scale(scale(b, area, made));
     counts.samples = made;
     counts.rays = tally.rays;
     counts.dropped = tally.dropped;
     counts
+}
+
+/// Adds `pending`'s splats to `film`, chain by chain, and empties them.
+fn merge(film: &mut Film, pending: &mut [Vec<Splat>]) {
+    for p in pending {
+        film.add_splats(p);
+        p.clear();
+    }
 }
 
 /// The splats' scale: `b` over the mutations per pixel made (pbrt-v3's `b /

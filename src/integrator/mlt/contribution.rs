@@ -32,7 +32,8 @@ pub struct Contribution {
 /// 2. the raster position `space.min + next_2d() * extent`, the time `next_1d()`, the lens
 ///    `next_2d()`; `generate_camera_subpath(.., t, ..)` (zero unless it made all `t` vertices);
 /// 3. `start_stream(LIGHT_STREAM)`, `generate_light_subpath(.., s, ..)` (zero unless it made
-///    all `s`);
+///    all `s`); acr makes none for `s = 1`, whose light vertex the connection samples itself,
+///    nor the camera ray for `t = 1`, which connects to a lens point of its own;
 /// 4. `start_stream(CONNECTION_STREAM)`, `connect(.., s, t, ..)` (which may move the raster
 ///    position, for `t = 1`), times `n_strategies` (one strategy chosen uniformly of them).
 pub trait PathContribution: Sync {

@@ -68,10 +68,29 @@ impl Ziggurat {
     /// One standard normal deviate from `rng`.
     #[inline]
     pub fn sample(&self, rng: &mut Pcg32) -> f32 {
+        let bits = rng.next_u32();
+        match self.in_box(bits) {
+            Some(x) => x,
+            None => self.finish(bits, rng),
+        }
+    }
+
+    /// The deviate of the generator's draw `bits` when it falls in its layer's box (the
+    /// common case: a table look-up and a compare), else `None` ([`Ziggurat::finish`]).
+    #[inline(always)]
+    pub fn in_box(&self, bits: u32) -> Option<f32> {
+        let i = bits as usize & (LAYERS - 1);
+        // Bits 8..31 as a signed number j; 2j + 1 is odd, in (-2^24, 2^24), exact in f32.
+        let m = ((bits as i32) >> 8) * 2 + 1;
+        (m.unsigned_abs() < self.k[i]).then(|| m as f32 * self.w[i])
+    }
+
+    /// The deviate of a draw `bits` outside its layer's box: the tail or the wedge, drawing
+    /// more from `rng` as needed.
+    #[inline(never)]
+    pub fn finish(&self, mut bits: u32, rng: &mut Pcg32) -> f32 {
         loop {
-            let bits = rng.next_u32();
             let i = bits as usize & (LAYERS - 1);
-            // Bits 8..31 as a signed number j; 2j + 1 is odd, in (-2^24, 2^24), exact in f32.
             let m = ((bits as i32) >> 8) * 2 + 1;
             let x = m as f32 * self.w[i];
             if m.unsigned_abs() < self.k[i] {
@@ -85,6 +104,7 @@ impl Ziggurat {
             if y < (-0.5 * x * x).exp() {
                 return x;
             }
+            bits = rng.next_u32();
         }
     }
 

@@ -164,7 +164,8 @@ impl MltSampler {
 
     /// Brings coordinate `index` up to the iteration under way (pbrt-v3's `EnsureReady`): the
     /// small steps it missed since it was last used are applied as one of their summed width.
-    #[inline]
+    /// Out of line: [`MltSampler::next_1d`] does the common case itself.
+    #[inline(never)]
     fn ensure_ready(&mut self, index: usize) {
         if index >= self.x.len() {
             self.grow(index + 1);
@@ -202,6 +203,22 @@ impl MltSampler {
 }
 
 impl MltSampler {
+    /// [`SampleSource::next_1d`]'s small step of coordinate `index` (moved at the last
+    /// iteration) whose draw `bits` fell outside its layer's box.
+    #[inline(never)]
+    fn small_step_finish(&mut self, index: usize, bits: u32) -> f32 {
+        let normal = self.normal.finish(bits, &mut self.rng);
+        let xi = &mut self.x[index];
+        xi.backup();
+        xi.value += normal * self.sigma;
+        xi.value -= xi.value.floor();
+        if xi.value >= 1.0 {
+            xi.value = 0.0;
+        }
+        xi.last_modified = self.current_iteration;
+        xi.value
+    }
+
     /// Makes room for `len` coordinates.
     #[cold]
     fn grow(&mut self, len: usize) {
@@ -210,9 +227,36 @@ impl MltSampler {
 }
 
 impl SampleSource for MltSampler {
-    #[inline]
+    /// The common case inline (a small step of a coordinate moved at the last iteration, its
+    /// deviate in its layer's box), the same values as [`MltSampler::ensure_ready`]'s: the
+    /// path asks for a coordinate a few dozen times a mutation, and a call each cost more
+    /// than the step.
+    #[inline(always)]
     fn next_1d(&mut self) -> f32 {
         let i = self.next_index();
+        if !self.large_step {
+            if let Some(xi) = self.x.get_mut(i) {
+                // Neither reset (moved since the last accepted large step) nor behind.
+                if xi.last_modified + 1 == self.current_iteration
+                    && xi.last_modified >= self.last_large_step_iteration
+                {
+                    let bits = self.rng.next_u32();
+                    if let Some(normal) = self.normal.in_box(bits) {
+                        xi.backup();
+                        let mut v = xi.value + normal * self.sigma;
+                        v -= v.floor();
+                        // `v - floor(v)` of a tiny negative v rounds to 1.
+                        if v >= 1.0 {
+                            v = 0.0;
+                        }
+                        xi.value = v;
+                        xi.last_modified = self.current_iteration;
+                        return v;
+                    }
+                    return self.small_step_finish(i, bits);
+                }
+            }
+        }
         self.ensure_ready(i);
         self.x[i].value
     }
