@@ -226,7 +226,7 @@ impl Traced {
     /// already): each sample's radiance and film sample written in place, in parallel. Read on
     /// one thread between batches, half of them from the other core's cache, the results kept
     /// the other thread idle for 2% of the CPU time on small scenes (docs/BENCHMARKS.md, "The
-    /// render loop's serial take").
+    /// small rows again: the serial take and the instances' walk").
     fn take_plain(&mut self, results: &[SampleResult], film: &Film, counts: &mut RenderCounts) {
         let n = results.len();
         let settings = film.settings();
