@@ -150,6 +150,9 @@ pub fn render_with_features(
     render_with(scene, &li, sampler, film, seed, stop, progress, features)
 }
 
+/// The fewest samples a thread takes at once in [`Traced::take_plain`].
+const TAKE_MIN_LEN: usize = 4096;
+
 /// A traced batch and what became of its samples, waiting for the sampler and the film.
 #[derive(Default)]
 struct Traced {
@@ -190,6 +193,9 @@ impl Traced {
         self.features.clear();
         self.splats.clear();
         let keep_features = film.collects_features();
+        if !split && !keep_features && features.is_none() {
+            return self.take_plain(results, film, counts);
+        }
         for (q, (l, rays, first_hit, splats)) in self.batch.iter().zip(results) {
             let (l, rays, first_hit) = (*l, *rays, *first_hit);
             self.splats.extend_from_slice(splats);
@@ -214,6 +220,51 @@ impl Traced {
             }
         }
         counts.samples += self.batch.len() as u64;
+    }
+
+    /// [`Traced::take`] where neither the streams nor the features are kept (cleared
+    /// already): each sample's radiance and film sample written in place, in parallel. Read on
+    /// one thread between batches, half of them from the other core's cache, the results kept
+    /// the other thread idle for 2% of the CPU time on small scenes (docs/BENCHMARKS.md, "The
+    /// small rows again: the serial take and the instances' walk").
+    fn take_plain(&mut self, results: &[SampleResult], film: &Film, counts: &mut RenderCounts) {
+        let n = results.len();
+        let settings = film.settings();
+        let valid = &mut self.valid[0];
+        self.radiance.resize(n, [0.0; 3]);
+        valid.resize(n, (Vec2::ZERO, Spectrum::ZERO));
+        let (rays, dropped, splats) = self
+            .radiance
+            .par_iter_mut()
+            .zip(valid.par_iter_mut())
+            .zip(results.par_iter().zip(self.batch.par_iter()))
+            .with_min_len(TAKE_MIN_LEN)
+            .map(|((r, v), ((l, rays, _, splats), q))| {
+                let ok = is_valid_radiance(*l);
+                if ok {
+                    let l = settings.clamp(*l);
+                    *r = l.to_array();
+                    *v = (Vec2::from(q.film), l);
+                } else {
+                    // NaN marks a dropped sample for adaptive samplers, which must skip it,
+                    // and here the film samples to leave out (a kept one is finite).
+                    *r = [f32::NAN; 3];
+                    *v = (Vec2::ZERO, Spectrum::NAN);
+                }
+                (u64::from(*rays), u64::from(!ok), splats.len())
+            })
+            .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+        if dropped > 0 {
+            valid.retain(|(_, l)| !l.x.is_nan());
+        }
+        if splats > 0 {
+            for (.., s) in results {
+                self.splats.extend_from_slice(s);
+            }
+        }
+        counts.rays += rays;
+        counts.dropped += dropped;
+        counts.samples += n as u64;
     }
 
     /// Gives the batch to the sampler (its time added to `in_sampler`), then to the film, with

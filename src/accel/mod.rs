@@ -575,8 +575,10 @@ impl Accel {
             return best;
         };
         let t_limit = best.map_or(t_max, |h| h.t);
-        let mut hit = obvhs::ray::RayHit::none();
-        tlas.ray_traverse(to_obvhs(ray, t_limit), &mut hit, |r, id| {
+        // Our walk, as the geometries': obvhs's orders a node's children by the ray's octant
+        // and visits every child it pushed (docs/BENCHMARKS.md, "The small rows again: the
+        // serial take and the instances' walk").
+        traverse::closest(tlas, to_obvhs(ray, t_limit), |r, id| {
             let index = self.tlas_order[id];
             let inst = &self.instances[index as usize];
             let local = inst.placement.local_ray(ray);
@@ -599,7 +601,7 @@ impl Accel {
         let Some(tlas) = &self.tlas else {
             return false;
         };
-        !tlas.ray_traverse_miss(to_obvhs(ray, t_max), |_, id| {
+        !traverse::misses(tlas, to_obvhs(ray, t_max), |_, id| {
             let inst = &self.instances[self.tlas_order[id] as usize];
             let local = inst.placement.local_ray(ray);
             if self.objects[inst.object as usize].occluded_instanced(&local, t_max) {
