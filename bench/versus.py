@@ -2,8 +2,9 @@
 """acr against pbrt-v3 and pbrt-v4: whole-process seconds and peak memory on the same scenes.
 
 Each scene renders at its own resolution and spp (pbrt-v3 has no spp flag, so no renderer gets
-one), with the same thread count, each run its own process; the time is wall clock from start to
-exit and the memory the process's peak resident set (wait4's ru_maxrss). pbrt-v4 renders the
+one), with the same thread count, each run its own process, the renderers' runs alternating
+(A B A B ...); the time is wall clock from start to exit and the memory the process's peak
+resident set. pbrt-v4 renders the
 scene as `pbrt --upgrade` rewrites it (written beside the original, so that relative Include and
 PLY paths resolve, and removed afterwards). A renderer whose binary is not given is left out.
 pbrt-v4 has no direct-lighting integrator: its upgrade turns pbrt-v3's `directlighting` into
@@ -176,22 +177,34 @@ def with_spp(scene, spp):
     return path
 
 
-def measure(label, cmd, runs):
-    """Median seconds and peak MiB over `runs` runs (one when it takes over LONG_RUN seconds),
-    or None after printing why it failed."""
-    times, peaks = [], []
+def measure_alternating(jobs, runs):
+    """Each job's (median seconds, peak MiB) over `runs` rounds, every round running each job
+    once in turn (A B C A B C ...) so that a drift of the machine's speed falls on all alike;
+    a job of over LONG_RUN seconds runs once. `jobs`: (key, label, cmd). A failed job's result
+    is None, after printing why."""
+    times = {key: [] for key, _, _ in jobs}
+    peaks = {key: [] for key, _, _ in jobs}
+    failed = set()
     for _ in range(runs):
-        seconds, peak, code, tail = run(cmd)
-        if code != 0:
-            print(f"  {label} failed ({code}): {tail}", file=sys.stderr)
-            return None
-        times.append(seconds)
-        peaks.append(peak)
-        # A run of minutes is not repeated: its noise is small against its length.
-        if seconds > LONG_RUN:
-            break
-    print(f"  {label}: {statistics.median(times):.2f} s, {max(peaks):.0f} MiB", file=sys.stderr)
-    return statistics.median(times), max(peaks)
+        for key, label, cmd in jobs:
+            if key in failed or (times[key] and times[key][-1] > LONG_RUN):
+                continue
+            seconds, peak, code, tail = run(cmd)
+            if code != 0:
+                print(f"  {label} failed ({code}): {tail}", file=sys.stderr)
+                failed.add(key)
+                continue
+            times[key].append(seconds)
+            peaks[key].append(peak)
+    results = {}
+    for key, label, _ in jobs:
+        if key in failed or not times[key]:
+            results[key] = None
+            continue
+        median = statistics.median(times[key])
+        print(f"  {label}: {median:.2f} s, {max(peaks[key]):.0f} MiB", file=sys.stderr)
+        results[key] = (median, max(peaks[key]))
+    return results
 
 
 def scenes(args):
@@ -325,44 +338,48 @@ def main():
 
 
 def render_all(original, scene, renderers, args, tmp):
-    """One table row: each renderer's (seconds, peak MiB) on `scene`, named after `original`."""
+    """One table row: each renderer's (seconds, peak MiB) on `scene`, named after `original`;
+    the renderers' runs alternate (`measure_alternating`)."""
     name = scene_name(original)
     if os.sep + "shared" + os.sep in original:
         name = f"{name} (pbrt-v3's)"
     print(name, file=sys.stderr)
     image = os.path.join(tmp, f"{name}.exr")
     threads = str(args.threads)
-    results = {}
+    jobs, work, v4 = [], None, None
     for label, binary in renderers:
         if label == "acr":
             cmd = [binary, "render", scene, "-o", image, "--threads", threads, "--quiet"]
-            results[label] = measure(label, cmd, args.runs)
+            jobs.append((label, label, cmd))
             if args.startup:
                 one = cmd + ["--pixelbounds", ONE_PIXEL]
-                results[f"{label} start-up"] = measure(f"{label} one pixel", one, args.runs)
+                jobs.append((f"{label} start-up", f"{label} one pixel", one))
         elif label == "pbrt-v3":
             cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, scene]
-            results[label] = measure(label, cmd, args.runs)
+            jobs.append((label, label, cmd))
         else:
             v4 = upgraded(binary, scene)
             if v4 is None:
-                results[label] = None
                 continue
-            try:
-                cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, v4]
-                results[label] = measure(label, cmd, args.runs)
-                if args.startup:
-                    one = cmd[:-1] + ["--pixelbounds", ONE_PIXEL, v4]
-                    results[f"{label} start-up"] = measure(f"{label} one pixel", one, args.runs)
-                work = v4_work(scene, v4)
-                acr = dict(renderers).get("acr")
-                if work and acr:
-                    cmd = [acr, "render", scene, "-o", image, "--threads", threads, "--quiet"]
-                    result = measure("acr as pbrt-v4's upgrade", cmd + work[0], args.runs)
-                    if result is not None:
-                        results["acr, pbrt-v4's work"] = (*result, work[1])
-            finally:
-                os.remove(v4)
+            cmd = [binary, "--nthreads", threads, "--quiet", "--outfile", image, v4]
+            jobs.append((label, label, cmd))
+            if args.startup:
+                one = cmd[:-1] + ["--pixelbounds", ONE_PIXEL, v4]
+                jobs.append((f"{label} start-up", f"{label} one pixel", one))
+            work = v4_work(scene, v4)
+            acr = dict(renderers).get("acr")
+            if work and acr:
+                cmd = [acr, "render", scene, "-o", image, "--threads", threads, "--quiet"]
+                jobs.append(("acr, pbrt-v4's work", "acr as pbrt-v4's upgrade", cmd + work[0]))
+    try:
+        results = measure_alternating(jobs, args.runs)
+    finally:
+        if v4 is not None:
+            os.remove(v4)
+    if "pbrt-v4" in dict(renderers) and "pbrt-v4" not in results:
+        results["pbrt-v4"] = None
+    if results.get("acr, pbrt-v4's work") is not None:
+        results["acr, pbrt-v4's work"] = (*results["acr, pbrt-v4's work"], work[1])
     return name, results
 
 
