@@ -63,10 +63,9 @@ def main():
     if not os.path.exists(main_file):
         sys.exit(f"{main_file} not found: SANMIGUEL_DIR is the sanmiguel/ folder of the scenes")
     os.makedirs(os.path.join(out, "geometry"), exist_ok=True)
-    for name in ["textures"]:
-        link = os.path.join(out, name)
-        if not os.path.lexists(link):
-            os.symlink(os.path.abspath(os.path.join(src, name)), link)
+    textures = os.path.join(out, "textures")
+    if not os.path.lexists(textures):
+        os.symlink(os.path.abspath(os.path.join(src, "textures")), textures)
     for name in sorted(os.listdir(os.path.join(src, "geometry"))):
         source = os.path.abspath(os.path.join(src, "geometry", name))
         target = os.path.join(out, "geometry", name)
