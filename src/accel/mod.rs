@@ -82,11 +82,12 @@ pub struct Geometry {
     bvh: Option<CwBvh>,
 }
 
-/// Above this many primitives a geometry's BVH is built by [`wide::build_wide_in`], below by
-/// obvhs's PLOC builder. On a million triangles the wide builder is 3.7x faster (0.3 s against
-/// 1.1 s), needs 190 MiB less and traces as fast; on the interiors (106,000 to 125,000
-/// primitives of very mixed sizes) PLOC's trees with its optimal wide collapse made the whole
-/// render 0.90x the CPU time of the wide builder's (docs/BENCHMARKS.md).
+/// Above this many primitives a geometry's BVH is built by [`wide::build_wide_in`] when one mesh
+/// holds at least half of them, otherwise by obvhs's PLOC builder. On a million triangles of one
+/// mesh the wide builder is 3.7x faster (0.3 s against 1.1 s), needs 190 MiB less and traces as
+/// fast; on geometry of very mixed sizes (the interiors' 106,000 to 125,000 primitives, San
+/// Miguel's 726,000 in 800 meshes) PLOC's trees with its optimal wide collapse are walked
+/// through 20% fewer nodes (docs/BENCHMARKS.md).
 const WIDE_BUILD_MIN: usize = 300_000;
 
 /// The BVH builders.
@@ -190,7 +191,10 @@ impl Geometry {
 
     /// Builds the BVH and reorders primitives into leaf order.
     pub fn build(&mut self) {
-        let builder = if self.prims.len() > WIDE_BUILD_MIN {
+        let largest_mesh = self.meshes.iter().map(TriangleMesh::triangle_count).max();
+        let builder = if self.prims.len() > WIDE_BUILD_MIN
+            && largest_mesh.unwrap_or(0) * 2 >= self.prims.len()
+        {
             BvhBuilder::Wide
         } else {
             BvhBuilder::Ploc

@@ -35,9 +35,10 @@ pub struct LightSample {
 pub struct EnvMap {
     mip: MipMap<Spectrum>,
     distribution: Distribution2D,
-    /// A one-pixel map's radiance and its distribution's (constant) density: such a map
-    /// needs no spherical coordinates for a lookup (pbrt-v3's constant environment).
-    constant: Option<(Spectrum, f32)>,
+    /// A one-pixel map's radiance (pbrt-v3's constant environment): such a map needs no
+    /// spherical coordinates for a lookup, and is sampled uniformly over the sphere, as
+    /// pbrt-v4 samples a constant environment (docs/pbrt-v3-compatibility.md, "Lights").
+    constant: Option<Spectrum>,
 }
 
 /// Which static world primitive emits.
@@ -172,12 +173,7 @@ impl EnvMap {
             }
         }
         let distribution = Distribution2D::new(&values, dw, dh);
-        let constant = (w == 1 && h == 1).then(|| {
-            (
-                mip.lookup_width(Vec2::splat(0.5), 0.0),
-                distribution.pdf(Vec2::splat(0.5)),
-            )
-        });
+        let constant = (w == 1 && h == 1).then(|| mip.lookup_width(Vec2::splat(0.5), 0.0));
         Self {
             mip,
             distribution,
@@ -362,6 +358,12 @@ impl Light {
                 ..
             } => {
                 let (wi, pdf, li) = match map {
+                    Some(EnvMap {
+                        constant: Some(c), ..
+                    }) => {
+                        let wi = crate::sampling::uniform_sample_sphere(u);
+                        (wi, 1.0 / (4.0 * PI), *l * *c)
+                    }
                     Some(m) => {
                         let (st, map_pdf) = m.distribution.sample(u);
                         if map_pdf == 0.0 {
@@ -378,7 +380,7 @@ impl Light {
                         (wi, map_pdf / (2.0 * PI * PI * sin_theta), *l * m.lookup(st))
                     }
                     None => {
-                        // Uniform over the sphere, as pbrt-v3 does for a constant map.
+                        // Uniform over the sphere, as a one-pixel map is.
                         let wi = crate::sampling::uniform_sample_sphere(u);
                         (wi, 1.0 / (4.0 * PI), *l)
                     }
@@ -460,8 +462,7 @@ impl Light {
                 ..
             } => match map {
                 Some(EnvMap {
-                    constant: Some((c, _)),
-                    ..
+                    constant: Some(c), ..
                 }) => *l * *c,
                 Some(m) => {
                     let wl = light_from_world.transform_vector3(d).normalize();
@@ -482,17 +483,8 @@ impl Light {
                 ..
             } => match map {
                 Some(EnvMap {
-                    constant: Some((_, pdf)),
-                    ..
-                }) => {
-                    let z = light_from_world.transform_vector3(d).normalize().z;
-                    let sin_theta = (1.0 - z * z).max(0.0).sqrt();
-                    if sin_theta == 0.0 {
-                        0.0
-                    } else {
-                        pdf / (2.0 * PI * PI * sin_theta)
-                    }
-                }
+                    constant: Some(_), ..
+                }) => 1.0 / (4.0 * PI),
                 Some(m) => {
                     let wl = light_from_world.transform_vector3(d).normalize();
                     let st = direction_to_st(wl);
