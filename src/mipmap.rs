@@ -242,25 +242,55 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
         if !(span.is_finite() && s0.is_finite() && t0.is_finite()) || span > 4096.0 {
             return map.bilerp((st + Vec2::splat(0.5)) / size);
         }
-        let lut = weight_lut();
         let (mut sum, mut sum_weights) = (T::ZERO, 0.0f32);
+        // Every column of the box inside the level: a column needs no wrapping.
+        let inside = s0 >= 0.0 && s1 < size.x;
+        let (abc, lut) = ([a, b, c], weight_lut());
+        let columns = s0 as i64..=s1 as i64;
         for it in t0 as i64..=t1 as i64 {
             let tt = it as f32 - st.y;
-            for is in s0 as i64..=s1 as i64 {
-                let ss = is as f32 - st.x;
-                let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
-                if r2 < 1.0 {
-                    let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
-                    let weight = lut[index];
-                    sum = sum + map.texel(is, it) * weight;
-                    sum_weights += weight;
-                }
+            let acc = (&mut sum, &mut sum_weights);
+            let row = map.row_start(it);
+            match (inside, row) {
+                (true, Some(row)) => scan_row(abc, st.x, tt, columns.clone(), acc, lut, |is| {
+                    map.at(row + is as usize)
+                }),
+                _ => scan_row(abc, st.x, tt, columns.clone(), acc, lut, |is| {
+                    map.texel_in_row(row, is)
+                }),
             }
         }
         if sum_weights > 0.0 {
             sum * (1.0 / sum_weights)
         } else {
             map.bilerp((st + Vec2::splat(0.5)) / size)
+        }
+    }
+}
+
+/// One row of pbrt-v3's EWA sum: each texel `is` of `columns` whose squared radius in the
+/// ellipse `abc` (`A`, `B`, `C`) about `s` is under 1, at `tt` from the centre's row, adds
+/// its `texel(is)`, weighted from `lut`, to `acc` (the sum and the weights' sum), in order.
+#[inline(always)]
+fn scan_row<T: TexValue>(
+    abc: [f32; 3],
+    s: f32,
+    tt: f32,
+    columns: std::ops::RangeInclusive<i64>,
+    acc: (&mut T, &mut f32),
+    lut: &[f32; WEIGHT_LUT_SIZE],
+    texel: impl Fn(i64) -> T,
+) {
+    let [a, b, c] = abc;
+    let (sum, sum_weights) = acc;
+    for is in columns {
+        let ss = is as f32 - s;
+        let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
+        if r2 < 1.0 {
+            let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
+            let weight = lut[index];
+            *sum = *sum + texel(is) * weight;
+            *sum_weights += weight;
         }
     }
 }
@@ -315,6 +345,103 @@ mod tests {
                     Vec2::new(-0.1 * scale, scale),
                 );
                 assert!((v - 0.7).abs() < 1e-5, "{scale}: {v}");
+            }
+        }
+    }
+
+    /// pbrt-v3's EWA loop as written: every texel of the bounding box tested, each wrapped.
+    fn ewa_every_texel<T: TexValue, S: Texels<T>>(
+        map: &ImageMap<T, S>,
+        st: Vec2,
+        d0: Vec2,
+        d1: Vec2,
+    ) -> Option<T> {
+        let size = Vec2::new(map.width() as f32, map.height() as f32);
+        let st = st * size - Vec2::splat(0.5);
+        let (d0, d1) = (d0 * size, d1 * size);
+        let mut a = d0.y * d0.y + d1.y * d1.y + 1.0;
+        let mut b = -2.0 * (d0.x * d0.y + d1.x * d1.y);
+        let mut c = d0.x * d0.x + d1.x * d1.x + 1.0;
+        let inv_f = 1.0 / (a * c - b * b * 0.25);
+        a *= inv_f;
+        b *= inv_f;
+        c *= inv_f;
+        let det = -b * b + 4.0 * a * c;
+        let inv_det = 1.0 / det;
+        let (u_sqrt, v_sqrt) = ((det * c).sqrt(), (a * det).sqrt());
+        let s0 = (st.x - 2.0 * inv_det * u_sqrt).ceil();
+        let s1 = (st.x + 2.0 * inv_det * u_sqrt).floor();
+        let t0 = (st.y - 2.0 * inv_det * v_sqrt).ceil();
+        let t1 = (st.y + 2.0 * inv_det * v_sqrt).floor();
+        let span = (s1 - s0).max(t1 - t0);
+        if !(span.is_finite() && s0.is_finite() && t0.is_finite()) || span > 4096.0 {
+            return None;
+        }
+        let lut = weight_lut();
+        let (mut sum, mut sum_weights) = (T::ZERO, 0.0f32);
+        for it in t0 as i64..=t1 as i64 {
+            let tt = it as f32 - st.y;
+            for is in s0 as i64..=s1 as i64 {
+                let ss = is as f32 - st.x;
+                let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
+                if r2 < 1.0 {
+                    let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
+                    let weight = lut[index];
+                    sum = sum + map.texel(is, it) * weight;
+                    sum_weights += weight;
+                }
+            }
+        }
+        (sum_weights > 0.0).then(|| sum * (1.0 / sum_weights))
+    }
+
+    /// Lookups at random points with random footprints, thin ellipses at every angle (no
+    /// anisotropy cap) and boxes that cross the edges included, against the loop over every
+    /// texel of the box: the same bits.
+    fn check_rows_against_every_texel<T: TexValue, S: Texels<T>>(map: &ImageMap<T, S>) {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let levels = Levels(std::slice::from_ref(map));
+        let mut compared = 0;
+        for k in 0..40_000 {
+            let st = Vec2::new(uniform() * 1.4 - 0.2, uniform() * 1.4 - 0.2);
+            let scale = [0.002, 0.02, 0.2, 2.0][k % 4];
+            let angle = uniform() * std::f32::consts::TAU;
+            let major = Vec2::new(angle.cos(), angle.sin()) * scale * uniform();
+            let minor = Vec2::new(-major.y, major.x) * [1.0, 0.3, 0.01, 1e-4, 0.0][k % 5];
+            let Some(want) = ewa_every_texel(map, st, major, minor) else {
+                continue;
+            };
+            let got = levels.ewa(0, st, major, minor);
+            for ch in 0..3 {
+                assert_eq!(
+                    got.channel(ch).to_bits(),
+                    want.channel(ch).to_bits(),
+                    "{st} {major} {minor}: {got:?} against {want:?}"
+                );
+            }
+            compared += 1;
+        }
+        assert!(compared > 30_000, "{compared}");
+    }
+
+    #[test]
+    fn ewa_over_each_row_s_range_sums_the_same_texels_as_over_the_box() {
+        for (w, h) in [(64, 32), (48, 20)] {
+            for wrap in [Wrap::Repeat, Wrap::Black, Wrap::Clamp] {
+                check_rows_against_every_texel(&image(w, h, wrap));
+                let bytes = (0..w * h * 3).map(|i| (i * 37 % 251) as u8).collect();
+                let lut =
+                    std::array::from_fn(|b| crate::spectrum::srgb_to_linear(b as f32 / 255.0));
+                let texels = ByteTexels::new(bytes, 3, lut);
+                let map: ImageMap<crate::geometry::Spectrum, _> =
+                    ImageMap::from_rows(w, h, texels, wrap);
+                check_rows_against_every_texel(&map);
             }
         }
     }
