@@ -37,15 +37,33 @@ enum Pyramid<T> {
     Bytes(Vec<ImageMap<T, ByteTexels>>),
 }
 
+/// How a pyramid filters, and what its texels allow.
+#[derive(Clone, Copy, Debug)]
+struct Filter {
+    /// Trilinear filtering instead of EWA.
+    trilinear: bool,
+    /// The largest ratio of the footprint's axes EWA keeps.
+    max_anisotropy: f32,
+    /// Every texel [`plain`]: a filtered value then is too, and weighted by 0 it is +0.
+    plain: bool,
+}
+
+/// The largest texel [`plain`] allows: no sum of a level's weighted texels, scaled by the
+/// weights' inverse sum, can overflow.
+const PLAIN_MAX: f32 = 1e20;
+
+/// Whether `v` is finite, not negative (its sign bit clear: not -0) and at most [`PLAIN_MAX`].
+fn plain(v: f32) -> bool {
+    v.is_sign_positive() && v <= PLAIN_MAX
+}
+
 /// An image pyramid with pbrt-v3's lookups.
 #[derive(Clone, Debug)]
 pub struct MipMap<T> {
     /// Level 0 (the image, resampled to powers of two) up to 1 x 1.
     levels: Pyramid<T>,
-    /// Trilinear filtering instead of EWA.
-    trilinear: bool,
-    /// The largest ratio of the footprint's axes EWA keeps.
-    max_anisotropy: f32,
+    /// How lookups filter.
+    filter: Filter,
 }
 
 impl<T: TexValue> MipMap<T> {
@@ -63,10 +81,18 @@ impl<T: TexValue> MipMap<T> {
         };
         let mut levels = Vec::new();
         build_levels(base, |level| levels.push(level));
+        let plain = levels.iter().all(|m| {
+            m.texels()
+                .iter()
+                .all(|&v| (0..3).all(|c| plain(v.channel(c))))
+        });
         Self {
             levels: Pyramid::Values(levels),
-            trilinear,
-            max_anisotropy,
+            filter: Filter {
+                trilinear,
+                max_anisotropy,
+                plain,
+            },
         }
     }
 
@@ -101,8 +127,12 @@ impl<T: TexValue> MipMap<T> {
         });
         Self {
             levels: Pyramid::Bytes(levels),
-            trilinear,
-            max_anisotropy,
+            // Every texel is a table value.
+            filter: Filter {
+                trilinear,
+                max_anisotropy,
+                plain: lut.iter().all(|&v| plain(v)),
+            },
         }
     }
 
@@ -149,10 +179,9 @@ impl<T: TexValue> MipMap<T> {
     /// The filtered value at `st` over the footprint `dst0`, `dst1` (pbrt-v3's
     /// `MIPMap::Lookup(st, dstdx, dstdy)`).
     pub fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
-        let (trilinear, max_anisotropy) = (self.trilinear, self.max_anisotropy);
         match &self.levels {
-            Pyramid::Values(l) => Levels(l).lookup(st, dst0, dst1, trilinear, max_anisotropy),
-            Pyramid::Bytes(l) => Levels(l).lookup(st, dst0, dst1, trilinear, max_anisotropy),
+            Pyramid::Values(l) => Levels(l).lookup(st, dst0, dst1, self.filter),
+            Pyramid::Bytes(l) => Levels(l).lookup(st, dst0, dst1, self.filter),
         }
     }
 }
@@ -187,7 +216,12 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
     }
 
     /// See [`MipMap::lookup`].
-    fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2, trilinear: bool, max_anisotropy: f32) -> T {
+    fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2, filter: Filter) -> T {
+        let Filter {
+            trilinear,
+            max_anisotropy,
+            plain,
+        } = filter;
         if !(dst0.is_finite() && dst1.is_finite()) {
             return self.triangle(0, st);
         }
@@ -212,7 +246,14 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
         let lod = (self.0.len() as f32 - 1.0 + minor_length.log2()).max(0.0);
         let i = lod.floor() as usize;
         let d = lod - i as f32;
-        self.ewa(i, st, major, minor) * (1.0 - d) + self.ewa(i + 1, st, major, minor) * d
+        // Weighted by 0 (a footprint at or under a level-0 texel, clamped to level 0), the
+        // coarser level's value would add +0: zero in its place keeps the same bits.
+        let coarser = if d == 0.0 && plain {
+            T::ZERO
+        } else {
+            self.ewa(i + 1, st, major, minor)
+        };
+        self.ewa(i, st, major, minor) * (1.0 - d) + coarser * d
     }
 
     /// pbrt-v3's EWA filter at one level.
@@ -431,7 +472,7 @@ mod tests {
     }
 
     #[test]
-    fn ewa_over_each_row_s_range_sums_the_same_texels_as_over_the_box() {
+    fn ewa_row_by_row_gives_the_bits_of_pbrt_v3s_loop() {
         for (w, h) in [(64, 32), (48, 20)] {
             for wrap in [Wrap::Repeat, Wrap::Black, Wrap::Clamp] {
                 check_rows_against_every_texel(&image(w, h, wrap));
@@ -443,6 +484,35 @@ mod tests {
                     ImageMap::from_rows(w, h, texels, wrap);
                 check_rows_against_every_texel(&map);
             }
+        }
+    }
+
+    #[test]
+    fn a_footprint_under_a_texel_skips_the_coarser_level_and_keeps_the_bits() {
+        let mip = MipMap::new(&image(64, 32, Wrap::Repeat), false, 8.0);
+        assert!(mip.filter.plain);
+        let Pyramid::Values(levels) = &mip.levels else {
+            panic!("values");
+        };
+        let levels = Levels(levels);
+        for k in 0..2000 {
+            let st = Vec2::new(k as f32 * 0.0137 % 1.0, k as f32 * 0.0291 % 1.0);
+            // Under a level-0 texel (1/64 wide): the level is clamped to 0.
+            let major = Vec2::new(0.004, 0.001 * (k % 7) as f32);
+            let minor = Vec2::new(-major.y, major.x) * 0.5;
+            let both =
+                levels.ewa(0, st, major, minor) * 1.0 + levels.ewa(1, st, major, minor) * 0.0;
+            assert_eq!(
+                mip.lookup(st, major, minor).to_bits(),
+                both.to_bits(),
+                "{st}"
+            );
+        }
+        for bad in [-0.0, -1e-3, f32::INFINITY, f32::NAN, 1e21] {
+            let mut texels = vec![0.5f32; 16];
+            texels[5] = bad;
+            let map = ImageMap::from_rows(4, 4, texels, Wrap::Clamp);
+            assert!(!MipMap::new(&map, false, 8.0).filter.plain, "{bad}");
         }
     }
 }
