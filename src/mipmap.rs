@@ -248,18 +248,28 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
         let d = lod - i as f32;
         // Weighted by 0 (a footprint at or under a level-0 texel, clamped to level 0), the
         // coarser level's value would add +0: zero in its place keeps the same bits.
-        let coarser = if d == 0.0 && plain {
-            T::ZERO
-        } else {
-            self.ewa(i + 1, st, major, minor)
-        };
-        self.ewa(i, st, major, minor) * (1.0 - d) + coarser * d
+        let skip = d == 0.0 && plain;
+        let fine = self.ellipse(i, st, major, minor);
+        let coarse = (!skip).then(|| self.ellipse(i + 1, st, major, minor));
+        // Both levels' rows asked for before either sum waits on them.
+        self.prefetch(i, &fine);
+        if let Some(e) = &coarse {
+            self.prefetch(i + 1, e);
+        }
+        let coarser = coarse.map_or(T::ZERO, |e| self.ewa_sum(i + 1, e));
+        self.ewa_sum(i, fine) * (1.0 - d) + coarser * d
     }
 
     /// pbrt-v3's EWA filter at one level.
+    #[cfg(test)]
     fn ewa(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
+        self.ewa_sum(level, self.ellipse(level, st, dst0, dst1))
+    }
+
+    /// pbrt-v3's EWA ellipse at `level`: its coefficients and bounding box in texels.
+    fn ellipse(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> Ellipse {
         let Some(map) = self.0.get(level) else {
-            return self.top();
+            return Ellipse::Top;
         };
         let size = Vec2::new(map.width() as f32, map.height() as f32);
         let st = st * size - Vec2::splat(0.5);
@@ -281,14 +291,40 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
         // A footprint that is not finite, or wider than any capped one can be: bilinear.
         let span = (s1 - s0).max(t1 - t0);
         if !(span.is_finite() && s0.is_finite() && t0.is_finite()) || span > 4096.0 {
-            return map.bilerp((st + Vec2::splat(0.5)) / size);
+            return Ellipse::Bilinear((st + Vec2::splat(0.5)) / size);
         }
+        Ellipse::Box {
+            abc: [a, b, c],
+            st,
+            s: [s0, s1],
+            t: [t0 as i64, t1 as i64],
+        }
+    }
+
+    /// Asks for the cache lines of `ellipse`'s rows at `level` ahead of [`Levels::ewa_sum`].
+    fn prefetch(&self, level: usize, ellipse: &Ellipse) {
+        if let (Some(map), Ellipse::Box { s, t, .. }) = (self.0.get(level), ellipse) {
+            for it in t[0]..=t[1] {
+                map.prefetch(s[0] as i64, it);
+                map.prefetch(s[1] as i64, it);
+            }
+        }
+    }
+
+    /// The EWA sum over `ellipse` at `level`.
+    fn ewa_sum(&self, level: usize, ellipse: Ellipse) -> T {
+        let (map, (abc, st, [s0, s1], [t0, t1])) = match (self.0.get(level), ellipse) {
+            (Some(map), Ellipse::Box { abc, st, s, t }) => (map, (abc, st, s, t)),
+            (Some(map), Ellipse::Bilinear(st)) => return map.bilerp(st),
+            _ => return self.top(),
+        };
+        let size = Vec2::new(map.width() as f32, map.height() as f32);
         let (mut sum, mut sum_weights) = (T::ZERO, 0.0f32);
         // Every column of the box inside the level: a column needs no wrapping.
         let inside = s0 >= 0.0 && s1 < size.x;
-        let (abc, lut) = ([a, b, c], weight_lut());
+        let lut = weight_lut();
         let columns = s0 as i64..=s1 as i64;
-        for it in t0 as i64..=t1 as i64 {
+        for it in t0..=t1 {
             let tt = it as f32 - st.y;
             let acc = (&mut sum, &mut sum_weights);
             let row = map.row_start(it);
@@ -307,6 +343,22 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
             map.bilerp((st + Vec2::splat(0.5)) / size)
         }
     }
+}
+
+/// pbrt-v3's EWA footprint at one level.
+enum Ellipse {
+    /// Past the last level: the top texel.
+    Top,
+    /// Not finite, or too wide: bilinear at (s, t).
+    Bilinear(Vec2),
+    /// The ellipse's `A`, `B`, `C` about `st` (in texels), and its bounding box's columns
+    /// (as floats) and rows.
+    Box {
+        abc: [f32; 3],
+        st: Vec2,
+        s: [f32; 2],
+        t: [i64; 2],
+    },
 }
 
 /// One row of pbrt-v3's EWA sum: each texel `is` of `columns` whose squared radius in the

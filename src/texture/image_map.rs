@@ -137,6 +137,14 @@ impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
         }
     }
 
+    /// Asks for the cache line of the texel at column `s`, row `t` (wrapped), without waiting.
+    #[inline(always)]
+    pub fn prefetch(&self, s: i64, t: i64) {
+        if let (Some(row), Some(s)) = (self.row_start(t), self.column(s)) {
+            self.texels.prefetch(row + s);
+        }
+    }
+
     /// The texel at column `s`, row `t` counted from the bottom, wrapped.
     #[inline]
     pub fn texel(&self, s: i64, t: i64) -> T {
