@@ -5,7 +5,8 @@
 //! `maxanisotropy`) by default or trilinear on request. Without a footprint (rays after the
 //! first bounce) a lookup is bilinear in the first level, as pbrt-v3's. The levels of an 8-bit
 //! image are kept in bytes, as pbrt-v4 keeps them (docs/pbrt-v3-compatibility.md, "Materials
-//! and textures").
+//! and textures"). EWA sums the texels pbrt-v3's loop sums, in its order, only faster
+//! (docs/BENCHMARKS.md, "Texture lookups' speed").
 
 use crate::texture::image_map::{ImageMap, Wrap};
 use crate::texture::pyramid::{build_levels, quantise, resample_up};
@@ -44,7 +45,8 @@ struct Filter {
     trilinear: bool,
     /// The largest ratio of the footprint's axes EWA keeps.
     max_anisotropy: f32,
-    /// Every texel [`plain`]: a filtered value then is too, and weighted by 0 it is +0.
+    /// Every texel [`plain`]: a filtered value is then finite and not negative, and weighted
+    /// by 0 it is +0.
     plain: bool,
 }
 
