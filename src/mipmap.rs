@@ -5,7 +5,8 @@
 //! `maxanisotropy`) by default or trilinear on request. Without a footprint (rays after the
 //! first bounce) a lookup is bilinear in the first level, as pbrt-v3's. The levels of an 8-bit
 //! image are kept in bytes, as pbrt-v4 keeps them (docs/pbrt-v3-compatibility.md, "Materials
-//! and textures").
+//! and textures"). EWA sums the texels pbrt-v3's loop sums, in its order, only faster
+//! (docs/BENCHMARKS.md, "Texture lookups' speed").
 
 use crate::texture::image_map::{ImageMap, Wrap};
 use crate::texture::pyramid::{build_levels, quantise, resample_up};
@@ -37,15 +38,34 @@ enum Pyramid<T> {
     Bytes(Vec<ImageMap<T, ByteTexels>>),
 }
 
+/// How a pyramid filters, and what its texels allow.
+#[derive(Clone, Copy, Debug)]
+struct Filter {
+    /// Trilinear filtering instead of EWA.
+    trilinear: bool,
+    /// The largest ratio of the footprint's axes EWA keeps.
+    max_anisotropy: f32,
+    /// Every texel [`plain`]: a filtered value is then finite and not negative, and weighted
+    /// by 0 it is +0.
+    plain: bool,
+}
+
+/// The largest texel [`plain`] allows: no sum of a level's weighted texels, scaled by the
+/// weights' inverse sum, can overflow.
+const PLAIN_MAX: f32 = 1e20;
+
+/// Whether `v` is finite, not negative (its sign bit clear: not -0) and at most [`PLAIN_MAX`].
+fn plain(v: f32) -> bool {
+    v.is_sign_positive() && v <= PLAIN_MAX
+}
+
 /// An image pyramid with pbrt-v3's lookups.
 #[derive(Clone, Debug)]
 pub struct MipMap<T> {
     /// Level 0 (the image, resampled to powers of two) up to 1 x 1.
     levels: Pyramid<T>,
-    /// Trilinear filtering instead of EWA.
-    trilinear: bool,
-    /// The largest ratio of the footprint's axes EWA keeps.
-    max_anisotropy: f32,
+    /// How lookups filter.
+    filter: Filter,
 }
 
 impl<T: TexValue> MipMap<T> {
@@ -63,10 +83,18 @@ impl<T: TexValue> MipMap<T> {
         };
         let mut levels = Vec::new();
         build_levels(base, |level| levels.push(level));
+        let plain = levels.iter().all(|m| {
+            m.texels()
+                .iter()
+                .all(|&v| (0..3).all(|c| plain(v.channel(c))))
+        });
         Self {
             levels: Pyramid::Values(levels),
-            trilinear,
-            max_anisotropy,
+            filter: Filter {
+                trilinear,
+                max_anisotropy,
+                plain,
+            },
         }
     }
 
@@ -101,8 +129,12 @@ impl<T: TexValue> MipMap<T> {
         });
         Self {
             levels: Pyramid::Bytes(levels),
-            trilinear,
-            max_anisotropy,
+            // Every texel is a table value.
+            filter: Filter {
+                trilinear,
+                max_anisotropy,
+                plain: lut.iter().all(|&v| plain(v)),
+            },
         }
     }
 
@@ -149,10 +181,9 @@ impl<T: TexValue> MipMap<T> {
     /// The filtered value at `st` over the footprint `dst0`, `dst1` (pbrt-v3's
     /// `MIPMap::Lookup(st, dstdx, dstdy)`).
     pub fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
-        let (trilinear, max_anisotropy) = (self.trilinear, self.max_anisotropy);
         match &self.levels {
-            Pyramid::Values(l) => Levels(l).lookup(st, dst0, dst1, trilinear, max_anisotropy),
-            Pyramid::Bytes(l) => Levels(l).lookup(st, dst0, dst1, trilinear, max_anisotropy),
+            Pyramid::Values(l) => Levels(l).lookup(st, dst0, dst1, self.filter),
+            Pyramid::Bytes(l) => Levels(l).lookup(st, dst0, dst1, self.filter),
         }
     }
 }
@@ -187,7 +218,12 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
     }
 
     /// See [`MipMap::lookup`].
-    fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2, trilinear: bool, max_anisotropy: f32) -> T {
+    fn lookup(&self, st: Vec2, dst0: Vec2, dst1: Vec2, filter: Filter) -> T {
+        let Filter {
+            trilinear,
+            max_anisotropy,
+            plain,
+        } = filter;
         if !(dst0.is_finite() && dst1.is_finite()) {
             return self.triangle(0, st);
         }
@@ -212,13 +248,30 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
         let lod = (self.0.len() as f32 - 1.0 + minor_length.log2()).max(0.0);
         let i = lod.floor() as usize;
         let d = lod - i as f32;
-        self.ewa(i, st, major, minor) * (1.0 - d) + self.ewa(i + 1, st, major, minor) * d
+        // Weighted by 0 (a footprint at or under a level-0 texel, clamped to level 0), the
+        // coarser level's value would add +0: zero in its place keeps the same bits.
+        let skip = d == 0.0 && plain;
+        let fine = self.ellipse(i, st, major, minor);
+        let coarse = (!skip).then(|| self.ellipse(i + 1, st, major, minor));
+        // Both levels' rows asked for before either sum waits on them.
+        self.prefetch(i, &fine);
+        if let Some(e) = &coarse {
+            self.prefetch(i + 1, e);
+        }
+        let coarser = coarse.map_or(T::ZERO, |e| self.ewa_sum(i + 1, e));
+        self.ewa_sum(i, fine) * (1.0 - d) + coarser * d
     }
 
     /// pbrt-v3's EWA filter at one level.
+    #[cfg(test)]
     fn ewa(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> T {
+        self.ewa_sum(level, self.ellipse(level, st, dst0, dst1))
+    }
+
+    /// pbrt-v3's EWA ellipse at `level`: its coefficients and bounding box in texels.
+    fn ellipse(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> Ellipse {
         let Some(map) = self.0.get(level) else {
-            return self.top();
+            return Ellipse::Top;
         };
         let size = Vec2::new(map.width() as f32, map.height() as f32);
         let st = st * size - Vec2::splat(0.5);
@@ -240,27 +293,99 @@ impl<T: TexValue, S: Texels<T>> Levels<'_, T, S> {
         // A footprint that is not finite, or wider than any capped one can be: bilinear.
         let span = (s1 - s0).max(t1 - t0);
         if !(span.is_finite() && s0.is_finite() && t0.is_finite()) || span > 4096.0 {
-            return map.bilerp((st + Vec2::splat(0.5)) / size);
+            return Ellipse::Bilinear((st + Vec2::splat(0.5)) / size);
         }
-        let lut = weight_lut();
+        Ellipse::Box {
+            abc: [a, b, c],
+            st,
+            s: [s0, s1],
+            t: [t0 as i64, t1 as i64],
+        }
+    }
+
+    /// Asks for the cache lines of `ellipse`'s rows at `level` ahead of [`Levels::ewa_sum`].
+    fn prefetch(&self, level: usize, ellipse: &Ellipse) {
+        if let (Some(map), Ellipse::Box { s, t, .. }) = (self.0.get(level), ellipse) {
+            for it in t[0]..=t[1] {
+                map.prefetch(s[0] as i64, it);
+                map.prefetch(s[1] as i64, it);
+            }
+        }
+    }
+
+    /// The EWA sum over `ellipse` at `level`.
+    fn ewa_sum(&self, level: usize, ellipse: Ellipse) -> T {
+        let (map, (abc, st, [s0, s1], [t0, t1])) = match (self.0.get(level), ellipse) {
+            (Some(map), Ellipse::Box { abc, st, s, t }) => (map, (abc, st, s, t)),
+            (Some(map), Ellipse::Bilinear(st)) => return map.bilerp(st),
+            _ => return self.top(),
+        };
+        let size = Vec2::new(map.width() as f32, map.height() as f32);
         let (mut sum, mut sum_weights) = (T::ZERO, 0.0f32);
-        for it in t0 as i64..=t1 as i64 {
+        // Every column of the box inside the level: a column needs no wrapping.
+        let inside = s0 >= 0.0 && s1 < size.x;
+        let lut = weight_lut();
+        let columns = s0 as i64..=s1 as i64;
+        for it in t0..=t1 {
             let tt = it as f32 - st.y;
-            for is in s0 as i64..=s1 as i64 {
-                let ss = is as f32 - st.x;
-                let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
-                if r2 < 1.0 {
-                    let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
-                    let weight = lut[index];
-                    sum = sum + map.texel(is, it) * weight;
-                    sum_weights += weight;
-                }
+            let acc = (&mut sum, &mut sum_weights);
+            let row = map.row_start(it);
+            match (inside, row) {
+                (true, Some(row)) => scan_row(abc, st.x, tt, columns.clone(), acc, lut, |is| {
+                    map.at(row + is as usize)
+                }),
+                _ => scan_row(abc, st.x, tt, columns.clone(), acc, lut, |is| {
+                    map.texel_in_row(row, is)
+                }),
             }
         }
         if sum_weights > 0.0 {
             sum * (1.0 / sum_weights)
         } else {
             map.bilerp((st + Vec2::splat(0.5)) / size)
+        }
+    }
+}
+
+/// pbrt-v3's EWA footprint at one level.
+enum Ellipse {
+    /// Past the last level: the top texel.
+    Top,
+    /// Not finite, or too wide: bilinear at (s, t).
+    Bilinear(Vec2),
+    /// The ellipse's `A`, `B`, `C` about `st` (in texels), and its bounding box's columns
+    /// (as floats) and rows.
+    Box {
+        abc: [f32; 3],
+        st: Vec2,
+        s: [f32; 2],
+        t: [i64; 2],
+    },
+}
+
+/// One row of pbrt-v3's EWA sum: each texel `is` of `columns` whose squared radius in the
+/// ellipse `abc` (`A`, `B`, `C`) about `s` is under 1, at `tt` from the centre's row, adds
+/// its `texel(is)`, weighted from `lut`, to `acc` (the sum and the weights' sum), in order.
+#[inline(always)]
+fn scan_row<T: TexValue>(
+    abc: [f32; 3],
+    s: f32,
+    tt: f32,
+    columns: std::ops::RangeInclusive<i64>,
+    acc: (&mut T, &mut f32),
+    lut: &[f32; WEIGHT_LUT_SIZE],
+    texel: impl Fn(i64) -> T,
+) {
+    let [a, b, c] = abc;
+    let (sum, sum_weights) = acc;
+    for is in columns {
+        let ss = is as f32 - s;
+        let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
+        if r2 < 1.0 {
+            let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
+            let weight = lut[index];
+            *sum = *sum + texel(is) * weight;
+            *sum_weights += weight;
         }
     }
 }
@@ -316,6 +441,132 @@ mod tests {
                 );
                 assert!((v - 0.7).abs() < 1e-5, "{scale}: {v}");
             }
+        }
+    }
+
+    /// pbrt-v3's EWA loop as written: every texel of the bounding box tested, each wrapped.
+    fn ewa_every_texel<T: TexValue, S: Texels<T>>(
+        map: &ImageMap<T, S>,
+        st: Vec2,
+        d0: Vec2,
+        d1: Vec2,
+    ) -> Option<T> {
+        let size = Vec2::new(map.width() as f32, map.height() as f32);
+        let st = st * size - Vec2::splat(0.5);
+        let (d0, d1) = (d0 * size, d1 * size);
+        let mut a = d0.y * d0.y + d1.y * d1.y + 1.0;
+        let mut b = -2.0 * (d0.x * d0.y + d1.x * d1.y);
+        let mut c = d0.x * d0.x + d1.x * d1.x + 1.0;
+        let inv_f = 1.0 / (a * c - b * b * 0.25);
+        a *= inv_f;
+        b *= inv_f;
+        c *= inv_f;
+        let det = -b * b + 4.0 * a * c;
+        let inv_det = 1.0 / det;
+        let (u_sqrt, v_sqrt) = ((det * c).sqrt(), (a * det).sqrt());
+        let s0 = (st.x - 2.0 * inv_det * u_sqrt).ceil();
+        let s1 = (st.x + 2.0 * inv_det * u_sqrt).floor();
+        let t0 = (st.y - 2.0 * inv_det * v_sqrt).ceil();
+        let t1 = (st.y + 2.0 * inv_det * v_sqrt).floor();
+        let span = (s1 - s0).max(t1 - t0);
+        if !(span.is_finite() && s0.is_finite() && t0.is_finite()) || span > 4096.0 {
+            return None;
+        }
+        let lut = weight_lut();
+        let (mut sum, mut sum_weights) = (T::ZERO, 0.0f32);
+        for it in t0 as i64..=t1 as i64 {
+            let tt = it as f32 - st.y;
+            for is in s0 as i64..=s1 as i64 {
+                let ss = is as f32 - st.x;
+                let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
+                if r2 < 1.0 {
+                    let index = ((r2 * WEIGHT_LUT_SIZE as f32) as usize).min(WEIGHT_LUT_SIZE - 1);
+                    let weight = lut[index];
+                    sum = sum + map.texel(is, it) * weight;
+                    sum_weights += weight;
+                }
+            }
+        }
+        (sum_weights > 0.0).then(|| sum * (1.0 / sum_weights))
+    }
+
+    /// Lookups at random points with random footprints, thin ellipses at every angle (no
+    /// anisotropy cap) and boxes that cross the edges included, against the loop over every
+    /// texel of the box: the same bits.
+    fn check_rows_against_every_texel<T: TexValue, S: Texels<T>>(map: &ImageMap<T, S>) {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let levels = Levels(std::slice::from_ref(map));
+        let mut compared = 0;
+        for k in 0..40_000 {
+            let st = Vec2::new(uniform() * 1.4 - 0.2, uniform() * 1.4 - 0.2);
+            let scale = [0.002, 0.02, 0.2, 2.0][k % 4];
+            let angle = uniform() * std::f32::consts::TAU;
+            let major = Vec2::new(angle.cos(), angle.sin()) * scale * uniform();
+            let minor = Vec2::new(-major.y, major.x) * [1.0, 0.3, 0.01, 1e-4, 0.0][k % 5];
+            let Some(want) = ewa_every_texel(map, st, major, minor) else {
+                continue;
+            };
+            let got = levels.ewa(0, st, major, minor);
+            for ch in 0..3 {
+                assert_eq!(
+                    got.channel(ch).to_bits(),
+                    want.channel(ch).to_bits(),
+                    "{st} {major} {minor}: {got:?} against {want:?}"
+                );
+            }
+            compared += 1;
+        }
+        assert!(compared > 30_000, "{compared}");
+    }
+
+    #[test]
+    fn ewa_row_by_row_gives_the_bits_of_pbrt_v3s_loop() {
+        for (w, h) in [(64, 32), (48, 20)] {
+            for wrap in [Wrap::Repeat, Wrap::Black, Wrap::Clamp] {
+                check_rows_against_every_texel(&image(w, h, wrap));
+                let bytes = (0..w * h * 3).map(|i| (i * 37 % 251) as u8).collect();
+                let lut =
+                    std::array::from_fn(|b| crate::spectrum::srgb_to_linear(b as f32 / 255.0));
+                let texels = ByteTexels::new(bytes, 3, lut);
+                let map: ImageMap<crate::geometry::Spectrum, _> =
+                    ImageMap::from_rows(w, h, texels, wrap);
+                check_rows_against_every_texel(&map);
+            }
+        }
+    }
+
+    #[test]
+    fn a_footprint_under_a_texel_skips_the_coarser_level_and_keeps_the_bits() {
+        let mip = MipMap::new(&image(64, 32, Wrap::Repeat), false, 8.0);
+        assert!(mip.filter.plain);
+        let Pyramid::Values(levels) = &mip.levels else {
+            panic!("values");
+        };
+        let levels = Levels(levels);
+        for k in 0..2000 {
+            let st = Vec2::new(k as f32 * 0.0137 % 1.0, k as f32 * 0.0291 % 1.0);
+            // Under a level-0 texel (1/64 wide): the level is clamped to 0.
+            let major = Vec2::new(0.004, 0.001 * (k % 7) as f32);
+            let minor = Vec2::new(-major.y, major.x) * 0.5;
+            let both =
+                levels.ewa(0, st, major, minor) * 1.0 + levels.ewa(1, st, major, minor) * 0.0;
+            assert_eq!(
+                mip.lookup(st, major, minor).to_bits(),
+                both.to_bits(),
+                "{st}"
+            );
+        }
+        for bad in [-0.0, -1e-3, f32::INFINITY, f32::NAN, 1e21] {
+            let mut texels = vec![0.5f32; 16];
+            texels[5] = bad;
+            let map = ImageMap::from_rows(4, 4, texels, Wrap::Clamp);
+            assert!(!MipMap::new(&map, false, 8.0).filter.plain, "{bad}");
         }
     }
 }

@@ -90,23 +90,65 @@ impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
         self.height
     }
 
+    /// Coordinate `v` of a side `n` texels long, wrapped: `None` where the wrap gives black.
+    #[inline(always)]
+    fn wrap_coord(&self, v: i64, n: usize) -> Option<usize> {
+        let n = n as i64;
+        match self.wrap {
+            // The mask is the Euclidean remainder by a power of two, without a division.
+            Wrap::Repeat if self.pow2 => Some((v & (n - 1)) as usize),
+            Wrap::Repeat => Some(v.rem_euclid(n) as usize),
+            Wrap::Clamp => Some(v.clamp(0, n - 1) as usize),
+            Wrap::Black => (0..n).contains(&v).then_some(v as usize),
+        }
+    }
+
+    /// Column `s` wrapped: `None` where the wrap gives black.
+    #[inline(always)]
+    pub fn column(&self, s: i64) -> Option<usize> {
+        self.wrap_coord(s, self.width)
+    }
+
+    /// The index of row `t`'s first texel, the row wrapped: `None` where the wrap gives black.
+    #[inline(always)]
+    pub fn row_start(&self, t: i64) -> Option<usize> {
+        self.wrap_coord(t, self.height).map(|t| t * self.width)
+    }
+
+    /// The texel at `index` (a [`ImageMap::row_start`] plus a [`ImageMap::column`]).
+    #[inline(always)]
+    pub fn at(&self, index: usize) -> T {
+        self.texels.get(index)
+    }
+
+    /// The texel at column `s` (wrapped here) of the row starting at `row` (from
+    /// [`ImageMap::row_start`]), black where either is.
+    #[inline(always)]
+    pub fn texel_in_row(&self, row: Option<usize>, s: i64) -> T {
+        self.at_wrapped(row, self.column(s))
+    }
+
+    /// The texel at row start `row`, column `s` (both wrapped already), black where either is.
+    #[inline(always)]
+    fn at_wrapped(&self, row: Option<usize>, s: Option<usize>) -> T {
+        match (row, s) {
+            (Some(row), Some(s)) => self.texels.get(row + s),
+            _ => T::ZERO,
+        }
+    }
+
+    /// Asks for the cache line of the texel at column `s`, row `t` (wrapped), without waiting.
+    #[inline(always)]
+    pub fn prefetch(&self, s: i64, t: i64) {
+        if let (Some(row), Some(s)) = (self.row_start(t), self.column(s)) {
+            self.texels.prefetch(row + s);
+        }
+    }
+
     /// The texel at column `s`, row `t` counted from the bottom, wrapped.
     #[inline]
     pub fn texel(&self, s: i64, t: i64) -> T {
-        let (w, h) = (self.width as i64, self.height as i64);
-        let (s, t) = match self.wrap {
-            // The mask is the Euclidean remainder by a power of two, without a division.
-            Wrap::Repeat if self.pow2 => (s & (w - 1), t & (h - 1)),
-            Wrap::Repeat => (s.rem_euclid(w), t.rem_euclid(h)),
-            Wrap::Clamp => (s.clamp(0, w - 1), t.clamp(0, h - 1)),
-            Wrap::Black => {
-                if s < 0 || s >= w || t < 0 || t >= h {
-                    return T::ZERO;
-                }
-                (s, t)
-            }
-        };
-        self.texels.get(t as usize * self.width + s as usize)
+        self.at_wrapped(self.row_start(t), self.column(s))
     }
 
     /// Bilinear interpolation at (s, t) in [0, 1]² (pbrt-v3's `MIPMap::triangle` at level 0).
@@ -125,9 +167,12 @@ impl<T: TexValue, S: Texels<T>> ImageMap<T, S> {
         let (s0, t0) = (s.floor(), t.floor());
         let (ds, dt) = (s - s0, t - t0);
         let (s0, t0) = (s0 as i64, t0 as i64);
-        self.texel(s0, t0) * ((1.0 - ds) * (1.0 - dt))
-            + self.texel(s0, t0 + 1) * ((1.0 - ds) * dt)
-            + self.texel(s0 + 1, t0) * (ds * (1.0 - dt))
-            + self.texel(s0 + 1, t0 + 1) * (ds * dt)
+        // Each coordinate wrapped once, not once a texel.
+        let (c0, c1) = (self.column(s0), self.column(s0 + 1));
+        let (r0, r1) = (self.row_start(t0), self.row_start(t0 + 1));
+        self.at_wrapped(r0, c0) * ((1.0 - ds) * (1.0 - dt))
+            + self.at_wrapped(r1, c0) * ((1.0 - ds) * dt)
+            + self.at_wrapped(r0, c1) * (ds * (1.0 - dt))
+            + self.at_wrapped(r1, c1) * (ds * dt)
     }
 }

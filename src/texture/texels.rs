@@ -11,6 +11,9 @@ pub trait Texels<T>: Clone + Debug + Send + Sync {
     fn get(&self, i: usize) -> T;
     /// Number of texels.
     fn len(&self) -> usize;
+    /// Asks for texel `i`'s cache line, without waiting for it.
+    #[inline(always)]
+    fn prefetch(&self, _i: usize) {}
     /// Whether there are no texels.
     fn is_empty(&self) -> bool {
         self.len() == 0
@@ -22,9 +25,26 @@ impl<T: TexValue> Texels<T> for Vec<T> {
     fn get(&self, i: usize) -> T {
         self[i]
     }
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        prefetch(self.as_ptr().wrapping_add(i));
+    }
     fn len(&self) -> usize {
         self.as_slice().len()
     }
+}
+
+/// Asks for the cache line holding `p`, without waiting for it.
+#[inline(always)]
+fn prefetch<P>(p: *const P) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing the program sees and never faults, whatever the address.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(p.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }
 
 /// Texels of 1 or 3 bytes each, a byte's value being `lut[byte]` (grey texels of a
@@ -61,6 +81,10 @@ impl<T: TexValue> Texels<T> for ByteTexels {
     }
     fn len(&self) -> usize {
         self.data.len() / self.channels
+    }
+    #[inline(always)]
+    fn prefetch(&self, i: usize) {
+        prefetch(self.data.as_ptr().wrapping_add(i * self.channels));
     }
 }
 
