@@ -166,12 +166,7 @@ pub fn quantise<T: TexValue>(
 }
 
 /// A row of texels into `out`, `channels` bytes a texel, as [`quantise`] stores them.
-pub(super) fn quantise_row<T: TexValue>(
-    row: &[T],
-    out: &mut [u8],
-    channels: usize,
-    quantiser: &Quantiser,
-) {
+fn quantise_row<T: TexValue>(row: &[T], out: &mut [u8], channels: usize, quantiser: &Quantiser) {
     for (bytes, v) in out.chunks_exact_mut(channels).zip(row) {
         for (c, b) in bytes.iter_mut().enumerate() {
             *b = quantiser.byte(v.channel(c));
