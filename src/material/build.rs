@@ -29,19 +29,6 @@ const KINDS: [&str; 14] = [
     "subsurface",
     "kdsubsurface",
 ];
-/// Material types whose build is cheap but for their image textures: a dry run builds them
-/// to find those images ([`build_materials`]).
-const DRY_RUN_KINDS: [&str; 9] = [
-    "matte",
-    "translucent",
-    "plastic",
-    "mirror",
-    "glass",
-    "metal",
-    "uber",
-    "substrate",
-    "disney",
-];
 /// Types that make no surface: rays pass through.
 const INTERFACE_KINDS: [&str; 3] = ["", "none", "interface"];
 /// Parameters pbrt-v3 (or pbrt-v4) materials take that acr ignores, with a warning.
@@ -186,26 +173,12 @@ pub fn build_materials(
     }
     let used = used_materials(desc);
     let n = desc.materials.len();
-    let builder = |textures| MaterialBuilder {
+    let mut b = MaterialBuilder {
         desc,
-        textures,
+        textures: TextureBuilder::new(desc, main_dir).with_render_from_world(render_from_world),
         built: vec![None; n],
         in_progress: vec![false; n],
     };
-    let textures = || TextureBuilder::new(desc, main_dir).with_render_from_world(render_from_world);
-    // A dry run records the image maps the materials ask for, so that they are read and built
-    // in parallel, file by file, rather than one after the other as materials ask; it leaves
-    // out the kinds whose build costs more than their textures (a table to read or compute),
-    // whose images are read when asked for. It marks used the parameters the build marks.
-    let mut dry = builder(textures().recording());
-    for (i, md) in desc.materials.iter().enumerate() {
-        if used[i] && DRY_RUN_KINDS.contains(&md.plugin.kind.as_str()) && dry.build(i).is_err() {
-            break;
-        }
-    }
-    let mut textures = textures();
-    textures.prebuild(dry.textures.take_requests());
-    let mut b = builder(textures);
     let mut out = Vec::with_capacity(n);
     for (i, md) in desc.materials.iter().enumerate() {
         if used[i] {

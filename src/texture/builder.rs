@@ -8,12 +8,11 @@ use acr_parser::{
     Warning,
 };
 use glam::{DMat4, Mat4};
-use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Debug;
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use super::source::{read_source, ByteImage, Source};
 use super::texels::Quantiser;
@@ -80,7 +79,7 @@ fn noise_pattern(kind: &str, p: &ParamList) -> Result<NoisePattern> {
 
 /// What identifies a converted image map and its MIP map (pbrt-v3's `TexInfo`).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub struct ImageKey {
+struct ImageKey {
     path: PathBuf,
     gamma: bool,
     scale: u32,
@@ -103,9 +102,7 @@ pub struct TextureBuilder<'a> {
     /// The last file decoded, for the next map of the same file.
     last_file: Option<(PathBuf, Arc<Source>)>,
     /// Quantisers by their table's bits (most textures share the sRGB one).
-    quantisers: Quantisers,
-    /// In a dry run ([`TextureBuilder::recording`]), the image maps asked for, in order.
-    requests: Option<Vec<(ImageKey, TextureValue)>>,
+    quantisers: HashMap<[u32; 256], Arc<Quantiser>>,
     float_maps: HashMap<ImageKey, Arc<MipMap<f32>>>,
     spectrum_maps: HashMap<ImageKey, Arc<MipMap<Spectrum>>>,
     warned: HashSet<String>,
@@ -113,9 +110,6 @@ pub struct TextureBuilder<'a> {
     /// Render space from world space (see [`crate::scene::Scene::render_from_world`]).
     render_from_world: DMat4,
 }
-
-/// Quantisers by their table's bits, shared by the threads that build MIP maps.
-type Quantisers = Mutex<HashMap<[u32; 256], Arc<Quantiser>>>;
 
 /// Per-value-type access to the builder's caches and parameter lookups.
 trait Build: TexValue {
@@ -184,8 +178,7 @@ impl<'a> TextureBuilder<'a> {
             spectra: vec![None; n],
             files: HashSet::new(),
             last_file: None,
-            quantisers: Mutex::new(HashMap::new()),
-            requests: None,
+            quantisers: HashMap::new(),
             float_maps: HashMap::new(),
             spectrum_maps: HashMap::new(),
             warned: HashSet::new(),
@@ -199,70 +192,6 @@ impl<'a> TextureBuilder<'a> {
     pub fn with_render_from_world(mut self, m: DMat4) -> Self {
         self.render_from_world = m;
         self
-    }
-
-    /// A builder for a dry run: image maps are not read but recorded (each gets a placeholder
-    /// of one black texel), for [`TextureBuilder::prebuild`] to build them all at once.
-    pub fn recording(mut self) -> Self {
-        self.requests = Some(Vec::new());
-        self
-    }
-
-    /// The image maps a dry run asked for.
-    pub fn take_requests(&mut self) -> Vec<(ImageKey, TextureValue)> {
-        self.requests.take().unwrap_or_default()
-    }
-
-    /// Reads and builds the image maps `requests` names, files in parallel (each file decoded
-    /// once, its maps built, then dropped), so that later lookups find them built. A file that
-    /// cannot be read is left for the lookup that names it to report. The maps are what a
-    /// lookup alone builds, whatever the order or the thread count.
-    pub fn prebuild(&mut self, requests: Vec<(ImageKey, TextureValue)>) {
-        let mut files: Vec<(PathBuf, Vec<(ImageKey, TextureValue)>)> = Vec::new();
-        let mut at: HashMap<PathBuf, usize> = HashMap::new();
-        for (key, kind) in requests {
-            let i = *at.entry(key.path.clone()).or_insert_with(|| {
-                files.push((key.path.clone(), Vec::new()));
-                files.len() - 1
-            });
-            files[i].1.push((key, kind));
-        }
-        let quantisers = &self.quantisers;
-        let built: Vec<_> = files
-            .into_par_iter()
-            .filter_map(|(path, keys)| {
-                let src = read_source(&path).ok()?;
-                let maps: Vec<_> =
-                    keys.into_iter()
-                        .map(|(key, kind)| {
-                            let map =
-                                match kind {
-                                    TextureValue::Float => Built::Float(Arc::new(
-                                        build_map::<f32>(&src, &key, quantisers),
-                                    )),
-                                    TextureValue::Spectrum => Built::Spectrum(Arc::new(
-                                        build_map::<Spectrum>(&src, &key, quantisers),
-                                    )),
-                                };
-                            (key, map)
-                        })
-                        .collect();
-                Some((path, maps))
-            })
-            .collect();
-        for (path, maps) in built {
-            self.files.insert(path);
-            for (key, map) in maps {
-                match map {
-                    Built::Float(m) => {
-                        self.float_maps.insert(key, m);
-                    }
-                    Built::Spectrum(m) => {
-                        self.spectrum_maps.insert(key, m);
-                    }
-                }
-            }
-        }
     }
 
     /// The main scene file's directory.
@@ -635,13 +564,6 @@ impl<'a> TextureBuilder<'a> {
         if let Some(m) = T::maps(self).get(&key) {
             return Ok(Arc::clone(m));
         }
-        if let Some(requests) = &mut self.requests {
-            requests.push((key.clone(), T::kind()));
-            let black = ImageMap::from_rows(1, 1, vec![T::ZERO], wrap);
-            let map = Arc::new(MipMap::from_image(black, trilinear, max_anisotropy));
-            T::maps(self).insert(key, Arc::clone(&map));
-            return Ok(map);
-        }
         let src = match &self.last_file {
             Some((p, src)) if *p == key_path => Arc::clone(src),
             _ => {
@@ -659,38 +581,21 @@ impl<'a> TextureBuilder<'a> {
                 src
             }
         };
-        let map = Arc::new(build_map::<T>(&src, &key, &self.quantisers));
+        let convert = |c| T::from_texel(c, scale, gamma, invert);
+        let map = Arc::new(match &*src {
+            Source::Values(img) => {
+                MipMap::from_image(ImageMap::new(img, wrap, convert), trilinear, max_anisotropy)
+            }
+            Source::Bytes(img) => byte_mipmap::<T>(
+                img,
+                convert,
+                &mut self.quantisers,
+                wrap,
+                (trilinear, max_anisotropy),
+            ),
+        });
         T::maps(self).insert(key, Arc::clone(&map));
         Ok(map)
-    }
-}
-
-/// A MIP map [`TextureBuilder::prebuild`] built, of either value type.
-enum Built {
-    Float(Arc<MipMap<f32>>),
-    Spectrum(Arc<MipMap<Spectrum>>),
-}
-
-/// The MIP map `key` describes, of the image `src`.
-fn build_map<T: Build>(src: &Source, key: &ImageKey, quantisers: &Quantisers) -> MipMap<T> {
-    let (scale, max_anisotropy) = (
-        f32::from_bits(key.scale),
-        f32::from_bits(key.max_anisotropy),
-    );
-    let convert = |c| T::from_texel(c, scale, key.gamma, key.invert);
-    match src {
-        Source::Values(img) => MipMap::from_image(
-            ImageMap::new(img, key.wrap, convert),
-            key.trilinear,
-            max_anisotropy,
-        ),
-        Source::Bytes(img) => byte_mipmap::<T>(
-            img,
-            convert,
-            quantisers,
-            key.wrap,
-            (key.trilinear, max_anisotropy),
-        ),
     }
 }
 
@@ -700,25 +605,19 @@ fn build_map<T: Build>(src: &Source, key: &ImageKey, quantisers: &Quantisers) ->
 fn byte_mipmap<T: Build>(
     img: &ByteImage,
     convert: impl Fn(Spectrum) -> T,
-    quantisers: &Quantisers,
+    quantisers: &mut HashMap<[u32; 256], Arc<Quantiser>>,
     wrap: Wrap,
     (trilinear, max_anisotropy): (bool, f32),
 ) -> MipMap<T> {
     let unit = img.unit;
     let lut: [f32; 256] = std::array::from_fn(|b| convert(Spectrum::splat(unit[b])).channel(0));
     let per_channel = img.channels == 1 || T::kind() == TextureValue::Spectrum;
-    let bits = lut.map(f32::to_bits);
-    let known = quantisers
-        .lock()
-        .map_or(None, |m| m.get(&bits).map(Arc::clone));
-    // Made outside the lock (another thread may make the same one: they are equal).
-    let quantiser = known.or_else(|| {
-        let q = Arc::new(Quantiser::new(&lut)?);
-        if let Ok(mut m) = quantisers.lock() {
-            m.insert(bits, Arc::clone(&q));
+    let quantiser = match quantisers.entry(lut.map(f32::to_bits)) {
+        std::collections::hash_map::Entry::Occupied(e) => Some(Arc::clone(e.get())),
+        std::collections::hash_map::Entry::Vacant(e) => {
+            Quantiser::new(&lut).map(|q| Arc::clone(e.insert(Arc::new(q))))
         }
-        Some(q)
-    });
+    };
     match quantiser.filter(|_| per_channel) {
         Some(q) => MipMap::from_bytes(img, &lut, &q, wrap, trilinear, max_anisotropy),
         None => MipMap::from_image(
