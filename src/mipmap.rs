@@ -8,8 +8,9 @@
 //! and textures"). EWA sums the texels pbrt-v3's loop sums, in its order, only faster
 //! (docs/BENCHMARKS.md, "Texture lookups' speed").
 
+use crate::texture::byte_pyramid::byte_levels;
 use crate::texture::image_map::{ImageMap, Wrap};
-use crate::texture::pyramid::{build_levels, quantise, resample_up};
+use crate::texture::pyramid::{build_levels, resample_up};
 use crate::texture::source::ByteImage;
 use crate::texture::texels::{ByteTexels, Quantiser, Texels};
 use crate::texture::value::TexValue;
@@ -99,8 +100,8 @@ impl<T: TexValue> MipMap<T> {
     }
 
     /// The pyramid of an 8-bit image whose byte `b` is worth `lut[b]`, kept in bytes: levels
-    /// are built in floats exactly as [`MipMap::new`] builds them, then each is stored as the
-    /// bytes `quantiser` finds nearest, but for a level 0 that is the image's own pixels, kept
+    /// are built in floats exactly as [`MipMap::new`] builds them (band by band,
+    /// [`crate::texture::byte_pyramid`]), each stored as the bytes `quantiser` finds nearest, but for a level 0 that is the image's own pixels, kept
     /// as they are. A grey image's bytes make every channel of a colour texel.
     pub fn from_bytes(
         image: &ByteImage,
@@ -110,23 +111,7 @@ impl<T: TexValue> MipMap<T> {
         trilinear: bool,
         max_anisotropy: f32,
     ) -> Self {
-        let values = image.to_map(wrap, |b| T::from_bytes(b, lut));
-        let own = image.width.is_power_of_two() && image.height.is_power_of_two();
-        let base = if own { values } else { resample_up(&values) };
-        let mut levels = Vec::new();
-        build_levels(base, |level| {
-            let stored = if own && levels.is_empty() {
-                let mut data = Vec::with_capacity(image.data.len());
-                for t in 0..image.height {
-                    data.extend_from_slice(image.row_from_bottom(t));
-                }
-                let texels = ByteTexels::new(data, image.channels, *lut);
-                ImageMap::from_rows(image.width, image.height, texels, wrap)
-            } else {
-                quantise(&level, image.channels, quantiser, lut)
-            };
-            levels.push(stored);
-        });
+        let levels = byte_levels(image, lut, quantiser, wrap);
         Self {
             levels: Pyramid::Bytes(levels),
             // Every texel is a table value.

@@ -396,14 +396,30 @@ impl Scene {
             warnings,
         )?;
         let mut b = Builder::new(desc, warnings, render_from_world);
-        let accel = b.accel()?;
+        // The materials (their image textures' decoding and MIP maps) and the geometry's
+        // BVHs need nothing of each other: built at once, each keeps the cores busy while the
+        // other waits on a serial step (a PNG's inflating, a BVH's top levels). Their warnings
+        // keep the order of a build one after the other.
+        let mut material_warnings = Vec::new();
+        let (accel, materials) = rayon::join(
+            || b.accel(),
+            || {
+                crate::material::build_materials(
+                    desc,
+                    &main_dir,
+                    render_from_world,
+                    &mut material_warnings,
+                )
+            },
+        );
+        let accel = accel?;
         let (lo, hi) = accel.bounds();
         let (world_center, world_radius) = bounding_sphere(lo, hi);
         // Area lights, now that the world geometry has its final layout.
         b.add_area_lights(&accel)?;
         b.add_lights(world_radius, &main_dir)?;
-        let materials =
-            crate::material::build_materials(desc, &main_dir, render_from_world, b.warnings)?;
+        let materials = materials?;
+        b.warnings.append(&mut material_warnings);
         let media = crate::medium::build_media(&desc.media, render_from_world, b.warnings)?;
         let infinite_lights = b
             .lights

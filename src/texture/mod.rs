@@ -25,6 +25,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 mod builder;
+pub mod byte_pyramid;
 pub mod image_map;
 mod mapping;
 pub mod pyramid;

@@ -23,7 +23,7 @@ fn lanczos(x: f32) -> f32 {
 }
 
 /// pbrt-v3's `resampleWeights`: per new texel, its first old texel and four weights.
-fn resample_weights(old: usize, new: usize) -> Vec<(i64, [f32; 4])> {
+pub(super) fn resample_weights(old: usize, new: usize) -> Vec<(i64, [f32; 4])> {
     let filter_width = 2.0f32;
     (0..new)
         .map(|i| {
@@ -42,7 +42,7 @@ fn resample_weights(old: usize, new: usize) -> Vec<(i64, [f32; 4])> {
 }
 
 /// Where texel `i` of a `size`-texel row lies after wrapping (`None`: black, outside).
-fn wrap_index(i: i64, size: usize, wrap: Wrap) -> Option<usize> {
+pub(super) fn wrap_index(i: i64, size: usize, wrap: Wrap) -> Option<usize> {
     let n = size as i64;
     match wrap {
         Wrap::Repeat => Some(i.rem_euclid(n) as usize),
@@ -160,13 +160,16 @@ pub fn quantise<T: TexValue>(
     let mut data = vec![0u8; w * level.height() * channels];
     data.par_chunks_mut(w * channels)
         .zip(level.texels().par_chunks(w))
-        .for_each(|(out, row)| {
-            for (bytes, v) in out.chunks_exact_mut(channels).zip(row) {
-                for (c, b) in bytes.iter_mut().enumerate() {
-                    *b = quantiser.byte(v.channel(c));
-                }
-            }
-        });
+        .for_each(|(out, row)| quantise_row(row, out, channels, quantiser));
     let texels = ByteTexels::new(data, channels, *lut);
     ImageMap::from_rows(w, level.height(), texels, level.wrap())
+}
+
+/// A row of texels into `out`, `channels` bytes a texel, as [`quantise`] stores them.
+fn quantise_row<T: TexValue>(row: &[T], out: &mut [u8], channels: usize, quantiser: &Quantiser) {
+    for (bytes, v) in out.chunks_exact_mut(channels).zip(row) {
+        for (c, b) in bytes.iter_mut().enumerate() {
+            *b = quantiser.byte(v.channel(c));
+        }
+    }
 }
