@@ -4,6 +4,7 @@
 //! arithmetic is the same whatever the thread count, so the levels are too.
 
 use super::image_map::{ImageMap, Wrap};
+#[cfg(test)]
 use super::texels::{ByteTexels, Quantiser};
 use super::value::TexValue;
 use rayon::prelude::*;
@@ -149,7 +150,9 @@ pub fn build_levels<T: TexValue>(base: ImageMap<T>, mut keep: impl FnMut(ImageMa
 }
 
 /// `level` stored in bytes: each channel of each texel the byte `quantiser` finds nearest
-/// (`channels` of them: 1 keeps a grey colour's first channel).
+/// (`channels` of them: 1 keeps a grey colour's first channel). The whole-level reference that
+/// [`super::byte_pyramid`]'s bands are tested against.
+#[cfg(test)]
 pub fn quantise<T: TexValue>(
     level: &ImageMap<T>,
     channels: usize,
@@ -158,18 +161,13 @@ pub fn quantise<T: TexValue>(
 ) -> ImageMap<T, ByteTexels> {
     let w = level.width();
     let mut data = vec![0u8; w * level.height() * channels];
-    data.par_chunks_mut(w * channels)
-        .zip(level.texels().par_chunks(w))
-        .for_each(|(out, row)| quantise_row(row, out, channels, quantiser));
-    let texels = ByteTexels::new(data, channels, *lut);
-    ImageMap::from_rows(w, level.height(), texels, level.wrap())
-}
-
-/// A row of texels into `out`, `channels` bytes a texel, as [`quantise`] stores them.
-fn quantise_row<T: TexValue>(row: &[T], out: &mut [u8], channels: usize, quantiser: &Quantiser) {
-    for (bytes, v) in out.chunks_exact_mut(channels).zip(row) {
-        for (c, b) in bytes.iter_mut().enumerate() {
-            *b = quantiser.byte(v.channel(c));
+    for (out, row) in data.chunks_mut(w * channels).zip(level.texels().chunks(w)) {
+        for (bytes, v) in out.chunks_exact_mut(channels).zip(row) {
+            for (c, b) in bytes.iter_mut().enumerate() {
+                *b = quantiser.byte(v.channel(c));
+            }
         }
     }
+    let texels = ByteTexels::new(data, channels, *lut);
+    ImageMap::from_rows(w, level.height(), texels, level.wrap())
 }
