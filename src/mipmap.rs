@@ -429,37 +429,24 @@ mod tests {
         }
     }
 
-    /// pbrt-v3's EWA loop as written: every texel of the bounding box tested, each wrapped.
+    /// pbrt-v3's EWA loop as written over `ellipse` (from [`Levels::ellipse`] at `map`'s
+    /// level): every texel of the bounding box tested, each wrapped.
     fn ewa_every_texel<T: TexValue, S: Texels<T>>(
         map: &ImageMap<T, S>,
-        st: Vec2,
-        d0: Vec2,
-        d1: Vec2,
+        ellipse: &Ellipse,
     ) -> Option<T> {
-        let size = Vec2::new(map.width() as f32, map.height() as f32);
-        let st = st * size - Vec2::splat(0.5);
-        let (d0, d1) = (d0 * size, d1 * size);
-        let mut a = d0.y * d0.y + d1.y * d1.y + 1.0;
-        let mut b = -2.0 * (d0.x * d0.y + d1.x * d1.y);
-        let mut c = d0.x * d0.x + d1.x * d1.x + 1.0;
-        let inv_f = 1.0 / (a * c - b * b * 0.25);
-        a *= inv_f;
-        b *= inv_f;
-        c *= inv_f;
-        let det = -b * b + 4.0 * a * c;
-        let inv_det = 1.0 / det;
-        let (u_sqrt, v_sqrt) = ((det * c).sqrt(), (a * det).sqrt());
-        let s0 = (st.x - 2.0 * inv_det * u_sqrt).ceil();
-        let s1 = (st.x + 2.0 * inv_det * u_sqrt).floor();
-        let t0 = (st.y - 2.0 * inv_det * v_sqrt).ceil();
-        let t1 = (st.y + 2.0 * inv_det * v_sqrt).floor();
-        let span = (s1 - s0).max(t1 - t0);
-        if !(span.is_finite() && s0.is_finite() && t0.is_finite()) || span > 4096.0 {
+        let &Ellipse::Box {
+            abc: [a, b, c],
+            st,
+            s: [s0, s1],
+            t: [t0, t1],
+        } = ellipse
+        else {
             return None;
-        }
+        };
         let lut = weight_lut();
         let (mut sum, mut sum_weights) = (T::ZERO, 0.0f32);
-        for it in t0 as i64..=t1 as i64 {
+        for it in t0..=t1 {
             let tt = it as f32 - st.y;
             for is in s0 as i64..=s1 as i64 {
                 let ss = is as f32 - st.x;
@@ -494,7 +481,8 @@ mod tests {
             let angle = uniform() * std::f32::consts::TAU;
             let major = Vec2::new(angle.cos(), angle.sin()) * scale * uniform();
             let minor = Vec2::new(-major.y, major.x) * [1.0, 0.3, 0.01, 1e-4, 0.0][k % 5];
-            let Some(want) = ewa_every_texel(map, st, major, minor) else {
+            let ellipse = levels.ellipse(0, st, major, minor);
+            let Some(want) = ewa_every_texel(map, &ellipse) else {
                 continue;
             };
             let got = levels.ewa(0, st, major, minor);
