@@ -239,33 +239,25 @@ fn halve_rows<const CH: usize>(r0: &[f32], r1: &[f32], out: &mut [f32], wrap: Wr
 }
 
 /// The level above `below` (`w` x `h`, sides powers of two, `ch` floats a texel), reading
-/// texels past a side of 1 as the lookups' wrap does ([`super::pyramid`]'s halving).
+/// texels past a side of 1 as the lookups' wrap does ([`super::pyramid`]'s halving): row pairs
+/// halved by [`halve_rows`], as the bands are.
 fn halve_level(below: &[f32], (w, h): (usize, usize), ch: usize, wrap: Wrap) -> Vec<f32> {
     let (sw, sh) = ((w / 2).max(1), (h / 2).max(1));
-    // Index of texel (s, t) wrapped; `None`: black. Sides are powers of two: repeat is a mask.
-    let at = |s: usize, t: usize| -> Option<usize> {
-        let (s, t) = match wrap {
-            Wrap::Repeat => (s & (w - 1), t & (h - 1)),
-            Wrap::Clamp => (s.min(w - 1), t.min(h - 1)),
-            Wrap::Black if s >= w || t >= h => return None,
-            Wrap::Black => (s, t),
-        };
-        Some((t * w + s) * ch)
-    };
+    let row = w * ch;
+    let black = vec![0.0f32; row];
     let mut out = vec![0.0f32; sw * sh * ch];
-    for t in 0..sh {
-        for s in 0..sw {
-            let quad = [
-                at(2 * s, 2 * t),
-                at(2 * s + 1, 2 * t),
-                at(2 * s, 2 * t + 1),
-                at(2 * s + 1, 2 * t + 1),
-            ];
-            for c in 0..ch {
-                let v = |i: Option<usize>| i.map_or(0.0, |i| below[i + c]);
-                out[(t * sw + s) * ch + c] =
-                    (v(quad[0]) + v(quad[1]) + v(quad[2]) + v(quad[3])) * 0.25;
-            }
+    for (t, o) in out.chunks_exact_mut(sw * ch).enumerate() {
+        let r0 = &below[2 * t * row..][..row];
+        // The row above the only one: itself when wrapped or clamped, black otherwise.
+        let r1 = match (h > 1, wrap) {
+            (true, _) => &below[(2 * t + 1) * row..][..row],
+            (false, Wrap::Black) => &black[..],
+            (false, _) => r0,
+        };
+        if ch == 1 {
+            halve_rows::<1>(r0, r1, o, wrap);
+        } else {
+            halve_rows::<3>(r0, r1, o, wrap);
         }
     }
     out
